@@ -1,0 +1,151 @@
+//! Measures the BVH build (igi's replacement for the OptiX acceleration structure of
+//! Marques and Santos) on a scene: median wall time of several builds, the tree's size
+//! and SAH cost, and a CPU traversal sanity figure.
+//!
+//! `cargo run --release -p igi-core --example bvh_build -- [SCENE.toml|MESH.obj] [RUNS]`
+//! (default: the conference room of `shared/scenes`, 5 runs). An OBJ is read as bare
+//! triangles with `tobj`, every face kept (the scene loader may drop degenerate ones).
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use igi_core::bvh::Bvh;
+use igi_core::scene::{load_scene, Triangle};
+use igi_core::Vec3;
+
+fn main() {
+    let mut args = std::env::args().skip(1);
+    let path = PathBuf::from(
+        args.next()
+            .unwrap_or_else(|| "/work/shared/scenes/conference/scene.toml".to_string()),
+    );
+    let runs: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(5).max(1);
+
+    let t = Instant::now();
+    let scene = if path.extension().is_some_and(|e| e == "obj") {
+        None
+    } else {
+        match load_scene(&path) {
+            Ok(s) => Some(s),
+            Err(e) => {
+                eprintln!("cannot load {}: {e}", path.display());
+                std::process::exit(1);
+            }
+        }
+    };
+    let triangles: Vec<Triangle> = match &scene {
+        Some(s) => s.triangles.clone(),
+        None => load_obj(&path),
+    };
+    println!(
+        "{}: {} triangles (loaded in {:.0} ms)",
+        path.display(),
+        triangles.len(),
+        t.elapsed().as_secs_f64() * 1e3
+    );
+    println!(
+        "threads: {}",
+        std::thread::available_parallelism().map_or(1, |n| n.get())
+    );
+
+    let mut times = vec![];
+    let mut bvh = None;
+    let cpu_start = process_cpu_seconds();
+    for _ in 0..runs {
+        let t = Instant::now();
+        let b = Bvh::build(&triangles);
+        times.push(t.elapsed().as_secs_f64() * 1e3);
+        bvh = Some(b);
+    }
+    let cpu = process_cpu_seconds().zip(cpu_start).map(|(b, a)| (b - a) / runs as f64);
+    let bvh = bvh.expect("at least one run");
+    times.sort_by(f64::total_cmp);
+    let s = &bvh.build_stats;
+    if let Some(cpu) = cpu {
+        // Less sensitive than wall time to other processes on a small machine.
+        println!("CPU time per build, all threads: {:.0} ms", cpu * 1e3);
+    }
+    println!(
+        "build: median {:.1} ms of {runs} (min {:.1}, max {:.1})",
+        times[runs / 2],
+        times[0],
+        times[runs - 1]
+    );
+    println!(
+        "nodes {} ({} KiB), leaves {}, max depth {}, max leaf {}, oversized leaves {}, SAH cost {:.2}",
+        s.nodes,
+        s.nodes * std::mem::size_of::<igi_core::bvh::BvhNode>() / 1024,
+        s.leaves,
+        s.max_depth,
+        s.max_leaf_size,
+        s.oversized_leaves,
+        s.sah_cost
+    );
+
+    // Primary rays of the scene's camera, on one core: a rough figure for the CPU twin.
+    let Some(scene) = scene else {
+        return;
+    };
+    let cam = scene.camera;
+    let (w, h) = (scene.film.width.min(400), scene.film.height.min(300));
+    let fwd = (cam.target - cam.eye).normalize();
+    let right = fwd.cross(cam.up).normalize();
+    let up = right.cross(fwd);
+    let tan = (cam.fov_y_deg.to_radians() * 0.5).tan();
+    let aspect = w as f32 / h as f32;
+    let t = Instant::now();
+    let mut hits = 0usize;
+    for y in 0..h {
+        for x in 0..w {
+            let px = (2.0 * (x as f32 + 0.5) / w as f32 - 1.0) * tan * aspect;
+            let py = (1.0 - 2.0 * (y as f32 + 0.5) / h as f32) * tan;
+            let d: Vec3 = (fwd + px * right + py * up).normalize();
+            hits += usize::from(bvh.trace_closest(cam.eye, d, f32::INFINITY).is_some());
+        }
+    }
+    let secs = t.elapsed().as_secs_f64();
+    println!(
+        "CPU closest hit, {w}x{h} camera rays on one thread: {:.2} Mrays/s, {:.1}% hit",
+        (w * h) as f64 / secs / 1e6,
+        100.0 * hits as f64 / (w * h) as f64
+    );
+}
+
+/// Every face of an OBJ as a triangle (positions only).
+fn load_obj(path: &std::path::Path) -> Vec<Triangle> {
+    let options = tobj::LoadOptions {
+        triangulate: true,
+        ..Default::default()
+    };
+    let (models, _) = tobj::load_obj(path, &options).unwrap_or_else(|e| {
+        eprintln!("cannot read {}: {e}", path.display());
+        std::process::exit(1);
+    });
+    let mut out = vec![];
+    for m in models {
+        let p = &m.mesh.positions;
+        let v = |i: u32| Vec3::new(p[3 * i as usize], p[3 * i as usize + 1], p[3 * i as usize + 2]);
+        for f in m.mesh.indices.chunks_exact(3) {
+            let v = [v(f[0]), v(f[1]), v(f[2])];
+            let n = (v[1] - v[0]).cross(v[2] - v[0]).normalize_or_zero();
+            out.push(Triangle {
+                v,
+                n: [n; 3],
+                material: 0,
+            });
+        }
+    }
+    out
+}
+
+/// User + system time of this process so far (all threads, finished ones included), from
+/// /proc/self/stat (Linux; clock ticks of 10 ms: meaningful over several builds).
+fn process_cpu_seconds() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // Fields after the command name (which ends with ')'): utime and stime are the 12th
+    // and 13th of them.
+    let rest = &stat[stat.rfind(')')? + 2..];
+    let fields: Vec<&str> = rest.split_whitespace().collect();
+    let ticks: f64 = fields.get(11)?.parse::<f64>().ok()? + fields.get(12)?.parse::<f64>().ok()?;
+    Some(ticks / 100.0)
+}

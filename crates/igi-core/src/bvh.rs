@@ -1,0 +1,229 @@
+//! The ray-tracing layer of igi: a binary BVH built on the CPU with a binned SAH, its GPU
+//! layout, and a CPU traversal that is the exact twin of `crates/igi-gpu/src/shaders/traverse.wgsl`.
+//!
+//! Marques and Santos ("Instant Global Illumination on the GPU using OptiX") traced every
+//! ray with OptiX; igi replaces OptiX with this layer. It answers the two queries of the
+//! paper's frame: closest hit (camera, mirror and particle rays) and any hit (shadow rays).
+//!
+//! * [`build`]: binned SAH (Wald 2007 style) over triangle centroids, built in parallel.
+//! * [`traverse`]: ray setup, the robust ray-box slab test (Ize, "Robust BVH Ray
+//!   Traversal", JCGT 2013), the watertight ray-triangle test (Woop, Benthin and Wald,
+//!   JCGT 2013), closest-hit and any-hit traversal, brute-force references, and the ray
+//!   origin offset of Wächter and Binder (Ray Tracing Gems, ch. 6).
+//!
+//! The WGSL twin must run the same algorithm in the same order: any change here is a
+//! change there (the GPU test `crates/igi-gpu/tests/traverse_gpu.rs` compares them).
+
+mod build;
+mod traverse;
+
+#[cfg(test)]
+mod tests;
+
+use bytemuck::{Pod, Zeroable};
+use glam::Vec3;
+
+use crate::scene::Triangle;
+
+pub use traverse::{
+    brute_force_any, brute_force_closest, offset_ray_origin, shadow_segment, Hit, NO_HIT,
+};
+
+/// Deepest level at which the builder still makes an interior node; a node range that
+/// reaches this depth becomes one leaf whatever its size. The root node has depth 0.
+///
+/// The traversal stack (`STACK_SIZE` in `traverse.wgsl`, equal to this value) holds only
+/// far *interior* children, at most one per interior ancestor of the node being visited:
+/// an entry is pushed at an interior node of depth d <= MAX_DEPTH - 1 while the stack
+/// holds at most d entries (one per ancestor), so it never holds more than MAX_DEPTH
+/// entries. Balanced SAH trees stay far below (log2 of the triangle count plus a few
+/// levels); the cap matters only for pathological inputs (e.g. exponentially spaced
+/// triangles), which then get one big leaf at the bottom instead of overflowing the stack.
+pub const MAX_DEPTH: u32 = 60;
+
+/// Largest leaf the SAH may choose; larger ranges are always split (unless they reach
+/// [`MAX_DEPTH`] or have identical centroids and cannot be told apart). Small leaves keep
+/// the work of neighbouring GPU threads similar.
+pub const MAX_LEAF_SIZE: usize = 4;
+
+/// Number of bins per axis for the SAH split search.
+pub const SAH_BINS: usize = 16;
+
+/// SAH cost of visiting one interior node, relative to [`SAH_INTERSECT_COST`].
+pub const SAH_TRAVERSAL_COST: f32 = 1.0;
+/// SAH cost of one ray-triangle test.
+pub const SAH_INTERSECT_COST: f32 = 1.0;
+
+/// One node of the binary BVH as the GPU reads it: the boxes of both children, so that one
+/// 64-byte fetch decides which children a ray visits and in which order.
+///
+/// Mirrors `struct BvhNode` of `scene.wgsl` (each `vec3<f32>` followed by a `u32` packs
+/// into 16 bytes, so the WGSL struct has no padding):
+///
+/// | bytes  | field     | meaning                                                      |
+/// |--------|-----------|--------------------------------------------------------------|
+/// | 0..12  | `a_min`   | child a: box minimum (x, y, z)                               |
+/// | 12..16 | `a_index` | child a: node index (interior) or first triangle (leaf)      |
+/// | 16..28 | `a_max`   | child a: box maximum (x, y, z)                               |
+/// | 28..32 | `a_count` | child a: 0 = interior node, n > 0 = leaf of n triangles      |
+/// | 32..44 | `b_min`   | child b: box minimum                                         |
+/// | 44..48 | `b_index` | child b: node index or first triangle                        |
+/// | 48..60 | `b_max`   | child b: box maximum                                         |
+/// | 60..64 | `b_count` | child b: 0 = interior node, n > 0 = leaf                     |
+///
+/// Leaf triangles are BVH slots `index .. index + count` of [`Bvh::tri_verts`]. An empty
+/// child (the second child of a root that is a single leaf, both children of the BVH of
+/// no triangles) has min = +inf, max = -inf, count 1, index 0: its box is never hit.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable, Debug, PartialEq)]
+pub struct BvhNode {
+    pub a_min: [f32; 3],
+    pub a_index: u32,
+    pub a_max: [f32; 3],
+    pub a_count: u32,
+    pub b_min: [f32; 3],
+    pub b_index: u32,
+    pub b_max: [f32; 3],
+    pub b_count: u32,
+}
+
+/// One child of a [`BvhNode`], unpacked.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BvhChild {
+    pub min: Vec3,
+    pub max: Vec3,
+    /// Node index (interior) or first BVH slot (leaf).
+    pub index: u32,
+    /// 0 for an interior node, the number of triangles for a leaf.
+    pub count: u32,
+}
+
+impl BvhChild {
+    /// The child that no ray hits: an inverted infinite box, a leaf of one triangle.
+    pub const EMPTY: BvhChild = BvhChild {
+        min: Vec3::INFINITY,
+        max: Vec3::NEG_INFINITY,
+        index: 0,
+        count: 1,
+    };
+
+    pub fn is_leaf(&self) -> bool {
+        self.count > 0
+    }
+}
+
+impl BvhNode {
+    pub fn new(a: BvhChild, b: BvhChild) -> BvhNode {
+        BvhNode {
+            a_min: a.min.to_array(),
+            a_index: a.index,
+            a_max: a.max.to_array(),
+            a_count: a.count,
+            b_min: b.min.to_array(),
+            b_index: b.index,
+            b_max: b.max.to_array(),
+            b_count: b.count,
+        }
+    }
+
+    pub fn a(&self) -> BvhChild {
+        BvhChild {
+            min: Vec3::from(self.a_min),
+            max: Vec3::from(self.a_max),
+            index: self.a_index,
+            count: self.a_count,
+        }
+    }
+
+    pub fn b(&self) -> BvhChild {
+        BvhChild {
+            min: Vec3::from(self.b_min),
+            max: Vec3::from(self.b_max),
+            index: self.b_index,
+            count: self.b_count,
+        }
+    }
+}
+
+/// What the build produced and how long it took.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct BuildStats {
+    /// Wall time of [`Bvh::build`], in milliseconds.
+    pub build_ms: f64,
+    pub triangles: usize,
+    /// Interior nodes (entries of [`Bvh::nodes`]).
+    pub nodes: usize,
+    pub leaves: usize,
+    /// Depth of the deepest leaf (children of the root have depth 1).
+    pub max_depth: u32,
+    pub max_leaf_size: u32,
+    /// Leaves that were forced by [`MAX_DEPTH`] or by identical centroids with more than
+    /// [`MAX_LEAF_SIZE`] triangles.
+    pub oversized_leaves: usize,
+    /// SAH cost of the tree, relative to the root box's surface area:
+    /// sum over interior nodes of C_t A(n)/A(root) + sum over leaves of C_i N A(l)/A(root).
+    pub sah_cost: f32,
+}
+
+/// A BVH over triangles, in the layout the GPU reads (`scene.wgsl`, bind group 0).
+#[derive(Clone, Debug)]
+pub struct Bvh {
+    /// Interior nodes; node 0 is the root.
+    pub nodes: Vec<BvhNode>,
+    /// Three vertices per triangle (xyz, w = 0), in BVH order (slot i at 3i..3i+3).
+    pub tri_verts: Vec<[f32; 4]>,
+    /// BVH slot -> index of the triangle in the slice given to [`Bvh::build`].
+    pub tri_order: Vec<u32>,
+    pub build_stats: BuildStats,
+}
+
+impl Bvh {
+    /// Build with a binned SAH (see [`build`](self) for the rules). Handles any input:
+    /// no triangles (a BVH that misses everything), degenerate triangles (their flat or
+    /// point boxes are kept; the triangle test never reports a hit on them), identical
+    /// centroids (split by index). Vertices must be finite.
+    pub fn build(triangles: &[Triangle]) -> Bvh {
+        build::build(triangles)
+    }
+
+    /// Same as [`Bvh::build`], from bare vertex triples.
+    pub fn build_from_vertices(triangles: &[[Vec3; 3]]) -> Bvh {
+        build::build_from_vertices(triangles)
+    }
+
+    /// Number of triangles (BVH slots).
+    pub fn triangle_count(&self) -> usize {
+        self.tri_order.len()
+    }
+
+    /// Vertices of the triangle in BVH slot `slot`.
+    pub fn triangle(&self, slot: u32) -> [Vec3; 3] {
+        let i = 3 * slot as usize;
+        let v = |k: usize| {
+            Vec3::new(
+                self.tri_verts[k][0],
+                self.tri_verts[k][1],
+                self.tri_verts[k][2],
+            )
+        };
+        [v(i), v(i + 1), v(i + 2)]
+    }
+
+    /// Box of the whole scene (min, max); inverted-infinite for no triangles.
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        let n = &self.nodes[0];
+        let (a, b) = (n.a(), n.b());
+        (a.min.min(b.min), a.max.max(b.max))
+    }
+
+    /// Closest hit with 0 < t < tmax, or None. `t` is in units of `dir` (which need not
+    /// be normalised); `Hit::tri` is a BVH slot ([`Bvh::tri_order`] maps it back).
+    pub fn trace_closest(&self, origin: Vec3, dir: Vec3, tmax: f32) -> Option<Hit> {
+        traverse::trace_closest(self, origin, dir, tmax)
+    }
+
+    /// Whether some triangle is hit with 0 < t < tmax (occlusion); stops at the first.
+    pub fn trace_any(&self, origin: Vec3, dir: Vec3, tmax: f32) -> bool {
+        traverse::trace_any(self, origin, dir, tmax)
+    }
+}

@@ -1,0 +1,694 @@
+//! Binned SAH builder (in the manner of Wald, "On fast construction of SAH-based bounding
+//! volume hierarchies", 2007).
+//!
+//! Every node range is binned into [`SAH_BINS`] bins per axis over its centroid bounds;
+//! the split with the lowest SAH cost among the 3 x (bins - 1) planes is taken. A range
+//! becomes a leaf when it has one triangle, when it has at most [`MAX_LEAF_SIZE`] and the
+//! SAH prefers a leaf, when it reaches [`MAX_DEPTH`], or when its centroids are all equal
+//! and it is small enough (otherwise such a range is split by index at its middle).
+//!
+//! Primitives are 32-byte boxes (`PrimRef`) partitioned in place, with their triangle
+//! indices in a parallel array, so that each level is two sequential passes over memory.
+//! The two subtrees of the top levels are built on separate threads (`std::thread::scope`);
+//! each thread writes its own node list, appended and re-indexed after the join, so nodes
+//! stay in depth-first order (left subtree before right) whatever the thread count.
+
+use std::time::Instant;
+
+use glam::{BVec3A, Vec3, Vec3A};
+
+use super::{
+    BuildStats, Bvh, BvhChild, BvhNode, MAX_DEPTH, MAX_LEAF_SIZE, SAH_BINS, SAH_INTERSECT_COST,
+    SAH_TRAVERSAL_COST,
+};
+use crate::scene::Triangle;
+
+/// Ranges smaller than this are not worth a thread.
+const PARALLEL_MIN_PRIMS: usize = 16 * 1024;
+
+/// Ranges up to this size are split by an exact SAH sweep over their sorted centroids
+/// instead of bins: most nodes of a tree are small, and for them the fixed cost of
+/// clearing and sweeping 3 x SAH_BINS bins dominates (and the exact sweep finds better
+/// splits).
+const SMALL_RANGE: usize = 12;
+
+/// See [`bin_count`].
+const FEW_BINS_BELOW: usize = 256;
+
+#[derive(Clone, Copy, Debug)]
+struct Aabb {
+    lo: Vec3A,
+    hi: Vec3A,
+}
+
+impl Aabb {
+    const EMPTY: Aabb = Aabb {
+        lo: Vec3A::INFINITY,
+        hi: Vec3A::NEG_INFINITY,
+    };
+
+    #[inline]
+    fn grow(&mut self, o: &Aabb) {
+        self.lo = self.lo.min(o.lo);
+        self.hi = self.hi.max(o.hi);
+    }
+
+    #[inline]
+    fn grow_point(&mut self, p: Vec3A) {
+        self.lo = self.lo.min(p);
+        self.hi = self.hi.max(p);
+    }
+
+    /// Half the surface area (the SAH only needs ratios); 0 for an empty box.
+    #[inline]
+    fn half_area(&self) -> f32 {
+        let e = (self.hi - self.lo).max(Vec3A::ZERO);
+        e.x * e.y + e.y * e.z + e.z * e.x
+    }
+
+    fn child(&self, index: u32, count: u32) -> BvhChild {
+        BvhChild {
+            min: self.lo.into(),
+            max: self.hi.into(),
+            index,
+            count,
+        }
+    }
+}
+
+/// Bounds of one triangle. Its centroid, doubled, is `lo + hi` (the factor 2 is the same
+/// for every primitive, so bins and splits do not care).
+#[derive(Clone, Copy, Debug)]
+struct PrimRef {
+    lo: Vec3A,
+    hi: Vec3A,
+}
+
+impl PrimRef {
+    #[inline]
+    fn centroid2(&self) -> Vec3A {
+        self.lo + self.hi
+    }
+}
+
+/// One node range to build.
+struct Task<'a> {
+    prims: &'a mut [PrimRef],
+    ids: &'a mut [u32],
+    /// BVH slot of `prims[0]`.
+    first: u32,
+    bounds: Aabb,
+    /// Bounds of the doubled centroids.
+    cbounds: Aabb,
+    depth: u32,
+}
+
+/// Build-wide settings.
+struct Limits {
+    /// Ranges at this depth become leaves ([`MAX_DEPTH`] outside tests).
+    max_depth: u32,
+    /// Levels whose two subtrees are built on separate threads.
+    par_levels: u32,
+}
+
+/// The chosen split: bins `< bin` of `axis` go left.
+struct Split {
+    axis: usize,
+    bin: u32,
+    /// Sum of A(child) N(child) over both children (half areas).
+    cost: f32,
+    left: Aabb,
+    right: Aabb,
+}
+
+/// 2^23: for 0 <= x < 2^22, the low mantissa bits of x + 2^23 are round(x).
+const ROUND_MAGIC: f32 = 8_388_608.0;
+const BIN_MASK: u32 = SAH_BINS as u32 - 1;
+const _: () = assert!(SAH_BINS.is_power_of_two() && SAH_BINS >= 4);
+
+/// Maps doubled centroids to bin indices for one node. Binning and partitioning must
+/// agree exactly, so both go through [`Binner::bin`]/[`Binner::bins`] (the same f32
+/// operations). Bin = round((c - cmin) (BINS - 1) / extent): monotone in c, the minimum
+/// centroid in bin 0 and the maximum in the last, so a split between them always exists.
+/// The rounding is done with [`ROUND_MAGIC`] and a mask rather than a float-to-int
+/// cast: the cast's saturation checks cost more than the rest of the binning, and the
+/// mask keeps any index (even of a NaN) inside the bins.
+struct Binner {
+    cmin: Vec3A,
+    scale: Vec3A,
+}
+
+/// Bins per axis for a range of `n` primitives: [`SAH_BINS`] for large ranges, half as
+/// many below [`FEW_BINS_BELOW`] primitives, where the fixed cost of clearing and
+/// sweeping the bins is a large share of the work and the split matters less.
+fn bin_count(n: usize) -> usize {
+    if n < FEW_BINS_BELOW {
+        SAH_BINS / 2
+    } else {
+        SAH_BINS
+    }
+}
+
+impl Binner {
+    fn new(cbounds: &Aabb, bins: usize) -> Binner {
+        debug_assert!(bins <= SAH_BINS);
+        let extent = cbounds.hi - cbounds.lo;
+        // Axes without extent get scale 0: everything in bin 0, and they are skipped.
+        let scale = Vec3A::select(
+            extent.cmpgt(Vec3A::ZERO),
+            Vec3A::splat((bins - 1) as f32) / extent,
+            Vec3A::ZERO,
+        );
+        Binner {
+            cmin: cbounds.lo,
+            scale,
+        }
+    }
+
+    #[inline]
+    fn bins(&self, c: Vec3A) -> [usize; 3] {
+        let x = (c - self.cmin) * self.scale + Vec3A::splat(ROUND_MAGIC);
+        [x.x, x.y, x.z].map(|x| (x.to_bits() & BIN_MASK) as usize)
+    }
+
+    #[inline]
+    fn bin(&self, c: Vec3A, axis: usize) -> u32 {
+        let x = (c[axis] - self.cmin[axis]) * self.scale[axis] + ROUND_MAGIC;
+        x.to_bits() & BIN_MASK
+    }
+}
+
+pub(super) fn build(triangles: &[Triangle]) -> Bvh {
+    build_impl(triangles.len(), |i| triangles[i].v, MAX_DEPTH)
+}
+
+pub(super) fn build_from_vertices(triangles: &[[Vec3; 3]]) -> Bvh {
+    build_impl(triangles.len(), |i| triangles[i], MAX_DEPTH)
+}
+
+/// With a lower depth cap, to test the cap without a pathological scene (a chain 60
+/// levels deep needs areas growing by a factor ~n per level: beyond f32's range).
+#[cfg(test)]
+pub(super) fn build_with_max_depth(triangles: &[[Vec3; 3]], max_depth: u32) -> Bvh {
+    assert!(
+        max_depth <= MAX_DEPTH,
+        "the traversal stack holds MAX_DEPTH entries"
+    );
+    build_impl(triangles.len(), |i| triangles[i], max_depth)
+}
+
+fn threads() -> usize {
+    std::thread::available_parallelism()
+        .map(|n| n.get())
+        .unwrap_or(1)
+        .clamp(1, 64)
+}
+
+/// Runs `f(chunk_start, chunk)` over `data` split into one chunk per thread, each chunk a
+/// multiple of `align` long.
+fn par_chunks<T: Send, F>(data: &mut [T], align: usize, f: F)
+where
+    F: Fn(usize, &mut [T]) + Sync,
+{
+    let n = data.len();
+    let t = threads();
+    if t == 1 || n < 4096 {
+        f(0, data);
+        return;
+    }
+    let chunk = n.div_ceil(t).next_multiple_of(align);
+    std::thread::scope(|s| {
+        for (k, c) in data.chunks_mut(chunk).enumerate() {
+            let f = &f;
+            s.spawn(move || f(k * chunk, c));
+        }
+    });
+}
+
+fn build_impl<F>(count: usize, tri: F, max_depth: u32) -> Bvh
+where
+    F: Fn(usize) -> [Vec3; 3] + Sync,
+{
+    let start = Instant::now();
+    // The GPU indexes tri_verts with 3 * slot + 2 in u32.
+    assert!(
+        count <= (u32::MAX / 3) as usize,
+        "too many triangles for one BVH: {count}"
+    );
+    if count == 0 {
+        let mut bvh = Bvh {
+            nodes: vec![BvhNode::new(BvhChild::EMPTY, BvhChild::EMPTY)],
+            tri_verts: vec![],
+            tri_order: vec![],
+            build_stats: BuildStats::default(),
+        };
+        bvh.build_stats = stats(&bvh, start);
+        return bvh;
+    }
+
+    let mut prims = vec![
+        PrimRef {
+            lo: Vec3A::ZERO,
+            hi: Vec3A::ZERO
+        };
+        count
+    ];
+    par_chunks(&mut prims, 1, |base, chunk| {
+        for (k, p) in chunk.iter_mut().enumerate() {
+            let [a, b, c] = tri(base + k).map(Vec3A::from);
+            let (lo, hi) = (a.min(b).min(c), a.max(b).max(c));
+            // A triangle with a non-finite vertex is never hit (the triangle test fails
+            // on it); a point box keeps it out of everyone's way and keeps centroids
+            // comparable (no NaN), which the sort of SmallSweep relies on.
+            *p = if lo.is_finite() && hi.is_finite() {
+                PrimRef { lo, hi }
+            } else {
+                PrimRef {
+                    lo: Vec3A::ZERO,
+                    hi: Vec3A::ZERO,
+                }
+            };
+        }
+    });
+    let mut ids: Vec<u32> = (0..count as u32).collect();
+    let (bounds, cbounds) = range_bounds(&prims);
+
+    let mut nodes = Vec::with_capacity(count);
+    let par_levels = threads().next_power_of_two().trailing_zeros() + 1;
+    let root = build_node(
+        Task {
+            prims: &mut prims,
+            ids: &mut ids,
+            first: 0,
+            bounds,
+            cbounds,
+            depth: 0,
+        },
+        &mut nodes,
+        &Limits {
+            max_depth,
+            par_levels,
+        },
+    );
+    if root.count > 0 {
+        // A root that is a leaf still needs an interior node 0 to hold its box.
+        debug_assert!(nodes.is_empty());
+        nodes.push(BvhNode::new(
+            bounds.child(root.index, root.count),
+            BvhChild::EMPTY,
+        ));
+    }
+    drop(prims);
+
+    let mut tri_verts = vec![[0.0f32; 4]; 3 * count];
+    par_chunks(&mut tri_verts, 3, |base, chunk| {
+        for (k, out) in chunk.chunks_exact_mut(3).enumerate() {
+            let v = tri(ids[base / 3 + k] as usize);
+            for (o, v) in out.iter_mut().zip(v) {
+                *o = [v.x, v.y, v.z, 0.0];
+            }
+        }
+    });
+
+    let mut bvh = Bvh {
+        nodes,
+        tri_verts,
+        tri_order: ids,
+        build_stats: BuildStats::default(),
+    };
+    bvh.build_stats = stats(&bvh, start);
+    bvh
+}
+
+/// Box and (doubled) centroid box of a range.
+fn range_bounds(prims: &[PrimRef]) -> (Aabb, Aabb) {
+    let mut b = Aabb::EMPTY;
+    let mut c = Aabb::EMPTY;
+    for p in prims {
+        b.lo = b.lo.min(p.lo);
+        b.hi = b.hi.max(p.hi);
+        c.grow_point(p.centroid2());
+    }
+    (b, c)
+}
+
+/// Builds the subtree of `task`; pushes its interior nodes to `out` (depth first, this
+/// node first) and returns the reference to it as a child: an interior node (count 0,
+/// index into `out`) or a leaf (count > 0, index = first BVH slot).
+fn build_node(task: Task<'_>, out: &mut Vec<BvhNode>, limits: &Limits) -> BvhChild {
+    let n = task.prims.len();
+    let leaf = task.bounds.child(task.first, n as u32);
+    if n == 1 || task.depth >= limits.max_depth {
+        return leaf;
+    }
+
+    let area = task.bounds.half_area();
+    let leaf_cost = SAH_INTERSECT_COST * n as f32 * area;
+    let worth_a_leaf = |split_cost: f32| {
+        n <= MAX_LEAF_SIZE
+            && leaf_cost <= SAH_TRAVERSAL_COST * area + SAH_INTERSECT_COST * split_cost
+    };
+
+    let (k, lb, lc, rb, rc) = if n <= SMALL_RANGE {
+        let sweep = SmallSweep::new(task.prims);
+        if worth_a_leaf(sweep.cost) {
+            return leaf;
+        }
+        sweep.apply(task.prims, task.ids)
+    } else {
+        match find_split(task.prims, &task.cbounds) {
+            Some(split) => {
+                if worth_a_leaf(split.cost) {
+                    return leaf;
+                }
+                let (k, lc, rc) = partition(task.prims, task.ids, &task.cbounds, &split);
+                debug_assert!(k > 0 && k < n);
+                (k, split.left, lc, split.right, rc)
+            }
+            None => {
+                // All centroids equal: nothing tells the triangles apart.
+                let k = n / 2;
+                let (lb, lc) = range_bounds(&task.prims[..k]);
+                let (rb, rc) = range_bounds(&task.prims[k..]);
+                (k, lb, lc, rb, rc)
+            }
+        }
+    };
+
+    let slot = out.len();
+    out.push(BvhNode::zeroed());
+    let depth = task.depth + 1;
+    let (lp, rp) = task.prims.split_at_mut(k);
+    let (li, ri) = task.ids.split_at_mut(k);
+    let left = Task {
+        prims: lp,
+        ids: li,
+        first: task.first,
+        bounds: lb,
+        cbounds: lc,
+        depth,
+    };
+    let right = Task {
+        prims: rp,
+        ids: ri,
+        first: task.first + k as u32,
+        bounds: rb,
+        cbounds: rc,
+        depth,
+    };
+
+    let (a, b) = if task.depth < limits.par_levels && n >= PARALLEL_MIN_PRIMS {
+        let mut right_nodes = Vec::with_capacity(n - k);
+        let (a, b) = std::thread::scope(|s| {
+            let handle = s.spawn(|| build_node(right, &mut right_nodes, limits));
+            let a = build_node(left, out, limits);
+            (a, handle.join().expect("BVH build thread panicked"))
+        });
+        // The right subtree numbered its nodes from 0: move them behind the left one.
+        let offset = out.len() as u32;
+        out.extend(right_nodes.into_iter().map(|mut node| {
+            if node.a_count == 0 {
+                node.a_index += offset;
+            }
+            if node.b_count == 0 {
+                node.b_index += offset;
+            }
+            node
+        }));
+        let mut b = b;
+        if b.count == 0 {
+            b.index += offset;
+        }
+        (a, b)
+    } else {
+        let a = build_node(left, out, limits);
+        let b = build_node(right, out, limits);
+        (a, b)
+    };
+    out[slot] = BvhNode::new(a, b);
+    BvhChild {
+        min: task.bounds.lo.into(),
+        max: task.bounds.hi.into(),
+        index: slot as u32,
+        count: 0,
+    }
+}
+
+use bytemuck::Zeroable;
+
+/// Exact SAH sweep of a small range (2..=SMALL_RANGE primitives): for each axis the
+/// primitives sorted by centroid, every split between neighbours in that order.
+struct SmallSweep {
+    n: usize,
+    axis: usize,
+    /// Split after `at` + 1 primitives of `order[axis]`.
+    at: usize,
+    cost: f32,
+    order: [[u8; SMALL_RANGE]; 3],
+}
+
+impl SmallSweep {
+    fn new(prims: &[PrimRef]) -> SmallSweep {
+        let n = prims.len();
+        debug_assert!((2..=SMALL_RANGE).contains(&n));
+        let mut sweep = SmallSweep {
+            n,
+            axis: 0,
+            at: 0,
+            cost: f32::INFINITY,
+            order: [[0; SMALL_RANGE]; 3],
+        };
+        let boxes = |k: u8| {
+            let p = &prims[k as usize];
+            Aabb { lo: p.lo, hi: p.hi }
+        };
+        if n == 2 {
+            // One primitive per side whatever the axis.
+            sweep.order[0][1] = 1;
+            sweep.cost = boxes(0).half_area() + boxes(1).half_area();
+            return sweep;
+        }
+        let mut c = [Vec3A::ZERO; SMALL_RANGE];
+        for (ci, p) in c.iter_mut().zip(prims) {
+            *ci = p.centroid2();
+        }
+        // Rank of each primitive along each axis (ties by index, so equal centroids are
+        // split by index): branch-free, all three axes at once.
+        let mut rank = [Vec3A::ZERO; SMALL_RANGE];
+        for i in 0..n {
+            let mut r = Vec3A::ZERO;
+            for (j, cj) in c[..n].iter().enumerate() {
+                let before = cj.cmplt(c[i]) | (cj.cmpeq(c[i]) & BVec3A::splat(j < i));
+                r += Vec3A::select(before, Vec3A::ONE, Vec3A::ZERO);
+            }
+            rank[i] = r;
+        }
+        for (i, r) in rank[..n].iter().enumerate() {
+            for axis in 0..3 {
+                sweep.order[axis][r[axis] as usize] = i as u8;
+            }
+        }
+        for axis in 0..3 {
+            let order = &sweep.order[axis];
+            let mut right = [0.0f32; SMALL_RANGE];
+            let mut acc = Aabb::EMPTY;
+            for i in (1..n).rev() {
+                acc.grow(&boxes(order[i]));
+                right[i - 1] = acc.half_area() * (n - i) as f32;
+            }
+            let mut acc = Aabb::EMPTY;
+            for i in 0..n - 1 {
+                acc.grow(&boxes(order[i]));
+                let cost = acc.half_area() * (i + 1) as f32 + right[i];
+                if cost < sweep.cost {
+                    (sweep.axis, sweep.at, sweep.cost) = (axis, i, cost);
+                }
+            }
+        }
+        sweep
+    }
+
+    /// Reorders the range by the chosen axis; returns the left count and the bounds and
+    /// centroid bounds of both sides.
+    fn apply(&self, prims: &mut [PrimRef], ids: &mut [u32]) -> (usize, Aabb, Aabb, Aabb, Aabb) {
+        let n = self.n;
+        let (mut p, mut d) = ([prims[0]; SMALL_RANGE], [0u32; SMALL_RANGE]);
+        for (i, &o) in self.order[self.axis].iter().take(n).enumerate() {
+            p[i] = prims[o as usize];
+            d[i] = ids[o as usize];
+        }
+        prims.copy_from_slice(&p[..n]);
+        ids.copy_from_slice(&d[..n]);
+        let k = self.at + 1;
+        let (lb, lc) = range_bounds(&prims[..k]);
+        let (rb, rc) = range_bounds(&prims[k..]);
+        (k, lb, lc, rb, rc)
+    }
+}
+
+/// Best SAH split of a range over [`SAH_BINS`] bins per axis, or None when all
+/// centroids are equal.
+fn find_split(prims: &[PrimRef], cbounds: &Aabb) -> Option<Split> {
+    let nb = bin_count(prims.len());
+    let binner = Binner::new(cbounds, nb);
+    let mut bins = [[Aabb::EMPTY; SAH_BINS]; 3];
+    let mut counts = [[0u32; SAH_BINS]; 3];
+    for p in prims {
+        let b = binner.bins(p.centroid2());
+        for axis in 0..3 {
+            let k = b[axis];
+            let bin = &mut bins[axis][k];
+            bin.lo = bin.lo.min(p.lo);
+            bin.hi = bin.hi.max(p.hi);
+            counts[axis][k] += 1;
+        }
+    }
+
+    let mut best: Option<(usize, u32, f32)> = None;
+    for axis in 0..3 {
+        if binner.scale[axis] == 0.0 {
+            continue;
+        }
+        // right_cost[i]: bins i+1.. as the right child.
+        let mut right_cost = [0.0f32; SAH_BINS];
+        let mut acc = Aabb::EMPTY;
+        let mut count = 0u32;
+        for i in (1..nb).rev() {
+            acc.grow(&bins[axis][i]);
+            count += counts[axis][i];
+            right_cost[i - 1] = if count > 0 {
+                acc.half_area() * count as f32
+            } else {
+                f32::INFINITY
+            };
+        }
+        let mut acc = Aabb::EMPTY;
+        let mut count = 0u32;
+        for i in 0..nb - 1 {
+            acc.grow(&bins[axis][i]);
+            count += counts[axis][i];
+            if count == 0 {
+                continue;
+            }
+            let cost = acc.half_area() * count as f32 + right_cost[i];
+            if cost < best.map_or(f32::INFINITY, |b| b.2) {
+                best = Some((axis, i as u32 + 1, cost));
+            }
+        }
+    }
+    let (axis, bin, cost) = best?;
+    let mut left = Aabb::EMPTY;
+    let mut right = Aabb::EMPTY;
+    for (i, b) in bins[axis][..nb].iter().enumerate() {
+        if (i as u32) < bin {
+            left.grow(b);
+        } else {
+            right.grow(b);
+        }
+    }
+    Some(Split {
+        axis,
+        bin,
+        cost,
+        left,
+        right,
+    })
+}
+
+/// Moves the primitives of bins `< split.bin` to the front (Hoare's scheme: only
+/// misplaced pairs are swapped); returns their count and the centroid bounds of both sides.
+fn partition(
+    prims: &mut [PrimRef],
+    ids: &mut [u32],
+    cbounds: &Aabb,
+    split: &Split,
+) -> (usize, Aabb, Aabb) {
+    let binner = Binner::new(cbounds, bin_count(prims.len()));
+    let left = |c: Vec3A| binner.bin(c, split.axis) < split.bin;
+    let mut lc = Aabb::EMPTY;
+    let mut rc = Aabb::EMPTY;
+    let mut i = 0;
+    let mut j = prims.len();
+    loop {
+        // prims[..i] are left, prims[j..] right.
+        let ci = loop {
+            if i == j {
+                return (i, lc, rc);
+            }
+            let c = prims[i].centroid2();
+            if !left(c) {
+                break c;
+            }
+            lc.grow_point(c);
+            i += 1;
+        };
+        let cj = loop {
+            let c = prims[j - 1].centroid2();
+            if left(c) {
+                break c;
+            }
+            rc.grow_point(c);
+            j -= 1;
+            if i == j {
+                // prims[i] (= the one just moved past) was right: all classified.
+                return (i, lc, rc);
+            }
+        };
+        // prims[i] belongs right, prims[j - 1] left, and i < j - 1.
+        prims.swap(i, j - 1);
+        ids.swap(i, j - 1);
+        lc.grow_point(cj);
+        rc.grow_point(ci);
+        i += 1;
+        j -= 1;
+    }
+}
+
+fn stats(bvh: &Bvh, start: Instant) -> BuildStats {
+    let mut s = BuildStats {
+        triangles: bvh.tri_order.len(),
+        nodes: bvh.nodes.len(),
+        ..BuildStats::default()
+    };
+    let area = |c: &BvhChild| {
+        let e = (c.max - c.min).max(Vec3::ZERO);
+        e.x * e.y + e.y * e.z + e.z * e.x
+    };
+    let (lo, hi) = bvh.bounds();
+    let root_area = area(&BvhChild {
+        min: lo,
+        max: hi,
+        index: 0,
+        count: 0,
+    });
+    let mut cost = SAH_TRAVERSAL_COST as f64;
+    let mut stack = vec![(0u32, 0u32)];
+    while let Some((node, depth)) = stack.pop() {
+        let n = &bvh.nodes[node as usize];
+        for c in [n.a(), n.b()] {
+            let a = if root_area > 0.0 {
+                (area(&c) / root_area) as f64
+            } else {
+                0.0
+            };
+            if c.is_leaf() {
+                if c.min.x > c.max.x {
+                    continue; // the empty child
+                }
+                s.leaves += 1;
+                s.max_depth = s.max_depth.max(depth + 1);
+                s.max_leaf_size = s.max_leaf_size.max(c.count);
+                if c.count as usize > MAX_LEAF_SIZE {
+                    s.oversized_leaves += 1;
+                }
+                cost += (SAH_INTERSECT_COST * c.count as f32) as f64 * a;
+            } else {
+                cost += SAH_TRAVERSAL_COST as f64 * a;
+                stack.push((c.index, depth + 1));
+            }
+        }
+    }
+    s.sah_cost = cost as f32;
+    s.build_ms = start.elapsed().as_secs_f64() * 1e3;
+    s
+}

@@ -1,0 +1,581 @@
+//! Tests of the BVH: layout, structure, traversal against brute force, watertightness,
+//! depth cap, ray offsets.
+
+use glam::Vec3;
+use rand::{Rng, SeedableRng};
+use rand_pcg::Pcg64;
+
+use super::*;
+
+fn rng(seed: u64) -> Pcg64 {
+    Pcg64::seed_from_u64(seed)
+}
+
+fn rand_vec(r: &mut Pcg64, lo: f32, hi: f32) -> Vec3 {
+    Vec3::new(
+        r.random_range(lo..hi),
+        r.random_range(lo..hi),
+        r.random_range(lo..hi),
+    )
+}
+
+fn rand_dir(r: &mut Pcg64) -> Vec3 {
+    loop {
+        let v = rand_vec(r, -1.0, 1.0);
+        let l = v.length_squared();
+        if l > 1e-4 && l <= 1.0 {
+            return v / l.sqrt();
+        }
+    }
+}
+
+/// `n` random triangles of size up to `size` with vertices in [-extent, extent]^3.
+fn random_triangles(r: &mut Pcg64, n: usize, extent: f32, size: f32) -> Vec<[Vec3; 3]> {
+    (0..n)
+        .map(|_| {
+            let c = rand_vec(r, -extent, extent);
+            [
+                c + rand_vec(r, -size, size),
+                c + rand_vec(r, -size, size),
+                c + rand_vec(r, -size, size),
+            ]
+        })
+        .collect()
+}
+
+/// Checks the structure: tri_order is a permutation, tri_verts follow it, every box
+/// contains what it holds, depth and stack bounds hold.
+fn check_structure(bvh: &Bvh, tris: &[[Vec3; 3]]) {
+    let n = tris.len();
+    assert_eq!(bvh.tri_order.len(), n);
+    assert_eq!(bvh.tri_verts.len(), 3 * n);
+    let mut seen = vec![false; n];
+    for (slot, &i) in bvh.tri_order.iter().enumerate() {
+        assert!(!seen[i as usize], "triangle {i} twice");
+        seen[i as usize] = true;
+        assert_eq!(bvh.triangle(slot as u32), tris[i as usize]);
+    }
+    let mut leaf_slots = vec![false; n];
+    let mut node_seen = vec![false; bvh.nodes.len()];
+    // (node, depth, its box)
+    let mut stack = vec![(0u32, 0u32, None::<(Vec3, Vec3)>)];
+    while let Some((node, depth, parent)) = stack.pop() {
+        assert!(depth < MAX_DEPTH, "interior node at depth {depth}");
+        assert!(!node_seen[node as usize], "node {node} reached twice");
+        node_seen[node as usize] = true;
+        let nd = bvh.nodes[node as usize];
+        for c in [nd.a(), nd.b()] {
+            if c.min.x > c.max.x {
+                assert_eq!((c.index, c.count), (0, 1), "empty child");
+                continue;
+            }
+            if let Some((lo, hi)) = parent {
+                assert!(c.min.cmpge(lo).all() && c.max.cmple(hi).all());
+            }
+            if c.is_leaf() {
+                for slot in c.index..c.index + c.count {
+                    assert!(!leaf_slots[slot as usize]);
+                    leaf_slots[slot as usize] = true;
+                    for v in bvh.triangle(slot) {
+                        assert!(v.cmpge(c.min).all() && v.cmple(c.max).all());
+                    }
+                }
+            } else {
+                stack.push((c.index, depth + 1, Some((c.min, c.max))));
+            }
+        }
+    }
+    assert!(leaf_slots.iter().all(|&s| s), "a slot in no leaf");
+    assert!(node_seen.iter().all(|&s| s), "an unreachable node");
+    assert!(bvh.build_stats.max_depth <= MAX_DEPTH);
+}
+
+/// The BVH's closest hit must be the brute force's (same triangle, or another at the
+/// bit-identical distance), its any-hit the same answer. Returns the number of hits.
+fn check_ray(bvh: &Bvh, tris: &[[Vec3; 3]], o: Vec3, d: Vec3, tmax: f32) -> usize {
+    let bf = brute_force_closest(tris, o, d, tmax);
+    let bh = bvh.trace_closest(o, d, tmax);
+    match (bf, bh) {
+        (None, None) => {}
+        (Some((i, t)), Some(h)) => {
+            let j = bvh.tri_order[h.tri as usize];
+            assert_eq!(
+                t.to_bits(),
+                h.t.to_bits(),
+                "ray {o} {d}: brute force t {t} (tri {i}), bvh t {} (tri {j})",
+                h.t
+            );
+            let [v0, v1, v2] = bvh.triangle(h.tri);
+            let p = v0 * (1.0 - h.u - h.v) + v1 * h.u + v2 * h.v;
+            let q = o + d * h.t;
+            let scale = 1.0 + v0.abs().max(v1.abs()).max(v2.abs()).max_element();
+            assert!((p - q).length() <= 1e-4 * scale, "barycentrics: {p} vs {q}");
+        }
+        (bf, bh) => panic!("ray {o} {d} tmax {tmax}: brute force {bf:?}, bvh {bh:?}"),
+    }
+    assert_eq!(
+        brute_force_any(tris, o, d, tmax),
+        bvh.trace_any(o, d, tmax),
+        "any-hit of ray {o} {d} tmax {tmax}"
+    );
+    assert_eq!(bf.is_some(), bvh.trace_any(o, d, tmax));
+    usize::from(bf.is_some())
+}
+
+#[test]
+fn node_layout_matches_wgsl() {
+    assert_eq!(std::mem::size_of::<BvhNode>(), 64);
+    assert_eq!(std::mem::align_of::<BvhNode>(), 4);
+    let offsets = [
+        std::mem::offset_of!(BvhNode, a_min),
+        std::mem::offset_of!(BvhNode, a_index),
+        std::mem::offset_of!(BvhNode, a_max),
+        std::mem::offset_of!(BvhNode, a_count),
+        std::mem::offset_of!(BvhNode, b_min),
+        std::mem::offset_of!(BvhNode, b_index),
+        std::mem::offset_of!(BvhNode, b_max),
+        std::mem::offset_of!(BvhNode, b_count),
+    ];
+    assert_eq!(offsets, [0, 12, 16, 28, 32, 44, 48, 60]);
+    assert_eq!(std::mem::size_of::<Hit>(), 16);
+}
+
+#[test]
+fn empty_bvh_misses_everything() {
+    let bvh = Bvh::build(&[]);
+    assert_eq!(bvh.nodes.len(), 1);
+    assert!(bvh.tri_verts.is_empty() && bvh.tri_order.is_empty());
+    let mut r = rng(1);
+    for _ in 0..100 {
+        let o = rand_vec(&mut r, -10.0, 10.0);
+        let d = rand_dir(&mut r);
+        assert!(bvh.trace_closest(o, d, f32::INFINITY).is_none());
+        assert!(!bvh.trace_any(o, d, f32::INFINITY));
+    }
+    // Rays along the axes, also through the origin.
+    for d in [Vec3::X, Vec3::NEG_Y, Vec3::Z] {
+        assert!(bvh.trace_closest(Vec3::ZERO, d, 1e30).is_none());
+    }
+}
+
+#[test]
+fn single_triangle() {
+    let tri = [
+        Vec3::new(0.0, 0.0, 0.0),
+        Vec3::new(1.0, 0.0, 0.0),
+        Vec3::new(0.0, 1.0, 0.0),
+    ];
+    let t = crate::scene::Triangle {
+        v: tri,
+        n: [Vec3::Z; 3],
+        material: 0,
+    };
+    let bvh = Bvh::build(&[t]);
+    assert_eq!(bvh.nodes.len(), 1);
+    assert_eq!(bvh.nodes[0].a_count, 1);
+    assert_eq!(bvh.nodes[0].b(), BvhChild::EMPTY);
+    check_structure(&bvh, &[tri]);
+    let h = bvh
+        .trace_closest(Vec3::new(0.25, 0.5, 2.0), Vec3::NEG_Z, 10.0)
+        .unwrap();
+    assert_eq!((h.t, h.tri, h.u, h.v), (2.0, 0, 0.25, 0.5));
+    // From below (two-sided), a non-normalised direction: t in units of dir.
+    let h = bvh
+        .trace_closest(Vec3::new(0.25, 0.25, -1.0), Vec3::new(0.0, 0.0, 4.0), 10.0)
+        .unwrap();
+    assert_eq!(h.t, 0.25);
+    // tmax is exclusive, and so is t = 0.
+    assert!(bvh
+        .trace_closest(Vec3::new(0.25, 0.5, 2.0), Vec3::NEG_Z, 2.0)
+        .is_none());
+    assert!(!bvh.trace_any(Vec3::new(0.25, 0.5, 0.0), Vec3::Z, 10.0));
+    // Edges and vertices count.
+    assert!(bvh.trace_any(Vec3::new(0.5, 0.0, 1.0), Vec3::NEG_Z, 10.0));
+    assert!(bvh.trace_any(Vec3::new(0.5, 0.5, 1.0), Vec3::NEG_Z, 10.0));
+    assert!(bvh.trace_any(Vec3::new(1.0, 0.0, 1.0), Vec3::NEG_Z, 10.0));
+    assert!(!bvh.trace_any(Vec3::new(0.5, 0.51, 1.0), Vec3::NEG_Z, 10.0));
+    // A zero direction hits nothing.
+    assert!(bvh
+        .trace_closest(Vec3::new(0.25, 0.25, 0.0), Vec3::ZERO, 10.0)
+        .is_none());
+}
+
+#[test]
+fn random_rays_match_brute_force() {
+    for (seed, n) in [(2u64, 2usize), (3, 5), (4, 37), (5, 500), (6, 3000)] {
+        let mut r = rng(seed);
+        let tris = random_triangles(&mut r, n, 10.0, 2.0);
+        let bvh = Bvh::build_from_vertices(&tris);
+        check_structure(&bvh, &tris);
+        let mut hits = 0;
+        let rays = 2000;
+        for k in 0..rays {
+            let o = rand_vec(&mut r, -14.0, 14.0);
+            let mut d = rand_dir(&mut r);
+            if k % 7 == 0 {
+                // Zero direction components: the finite-reciprocal slab path.
+                d[k % 3] = 0.0;
+                if k % 2 == 0 {
+                    d[(k + 1) % 3] = -0.0;
+                }
+                if d == Vec3::ZERO {
+                    d = Vec3::X;
+                }
+            }
+            // Unnormalised directions and finite tmax (segments) too.
+            let (d, tmax) = match k % 3 {
+                0 => (d, f32::INFINITY),
+                1 => (d * 3.7, 2.0),
+                _ => (rand_vec(&mut r, -14.0, 14.0) - o, 1.0),
+            };
+            hits += check_ray(&bvh, &tris, o, d, tmax);
+        }
+        assert!(
+            n < 500 || hits > rays / 20,
+            "too few hits ({hits}) to mean anything"
+        );
+    }
+}
+
+#[test]
+fn degenerate_and_identical_triangles() {
+    let mut r = rng(7);
+    let mut tris = random_triangles(&mut r, 200, 5.0, 1.0);
+    // Zero-area triangles: a point, collinear vertices, a repeated vertex.
+    let p = Vec3::new(0.5, 0.5, 0.5);
+    tris.push([p, p, p]);
+    tris.push([p, p + Vec3::X, p + 2.0 * Vec3::X]);
+    tris.push([p, p, p + Vec3::Y]);
+    // 50 copies of one triangle (identical centroids: split by index), and 50 different
+    // triangles sharing one centroid.
+    let t = [
+        Vec3::new(-1.0, 0.0, 0.0),
+        Vec3::new(1.0, 0.0, 0.0),
+        Vec3::new(0.0, 2.0, 0.0),
+    ];
+    tris.extend(std::iter::repeat_n(t, 50));
+    let c = Vec3::new(2.0, -1.0, 3.0);
+    for k in 0..50 {
+        let a = k as f32 * 0.1;
+        let (s, co) = a.sin_cos();
+        let u = Vec3::new(co, s, 0.3) * 0.5;
+        let v = Vec3::new(-s, co, -0.2) * 0.5;
+        tris.push([c + u, c + v, c - u - v]);
+    }
+    let bvh = Bvh::build_from_vertices(&tris);
+    check_structure(&bvh, &tris);
+    for _ in 0..3000 {
+        let o = rand_vec(&mut r, -7.0, 7.0);
+        let d = rand_dir(&mut r);
+        check_ray(&bvh, &tris, o, d, f32::INFINITY);
+    }
+    // Only identical triangles: the whole tree is index splits.
+    let same = vec![t; 1000];
+    let bvh = Bvh::build_from_vertices(&same);
+    check_structure(&bvh, &same);
+    assert!(bvh.build_stats.max_leaf_size as usize <= MAX_LEAF_SIZE);
+    let h = bvh
+        .trace_closest(Vec3::new(0.0, 0.5, -3.0), Vec3::Z, 10.0)
+        .unwrap();
+    assert_eq!(h.t, 3.0);
+    assert!(bvh.trace_any(Vec3::new(0.0, 0.5, -3.0), Vec3::Z, 10.0));
+    // Only degenerate triangles: built, never hit.
+    let flat = vec![[p, p + Vec3::X, p + 2.0 * Vec3::X]; 10];
+    let bvh = Bvh::build_from_vertices(&flat);
+    check_structure(&bvh, &flat);
+    assert!(!bvh.trace_any(p + Vec3::new(0.5, 0.0, -1.0), Vec3::Z, 10.0));
+}
+
+#[test]
+fn depth_cap_makes_a_leaf_and_stays_correct() {
+    let mut r = rng(8);
+    let tris = random_triangles(&mut r, 3000, 10.0, 1.0);
+    let full = Bvh::build_from_vertices(&tris);
+    assert!(full.build_stats.max_depth > 8, "{:?}", full.build_stats);
+    let bvh = super::build::build_with_max_depth(&tris, 8);
+    check_structure(&bvh, &tris);
+    let s = &bvh.build_stats;
+    assert_eq!(s.max_depth, 8, "{s:?}");
+    assert!(s.oversized_leaves >= 1 && s.max_leaf_size > 10, "{s:?}");
+    assert!(s.leaves <= 1 << 8);
+    for _ in 0..3000 {
+        let o = rand_vec(&mut r, -12.0, 12.0);
+        let d = rand_dir(&mut r);
+        check_ray(&bvh, &tris, o, d, f32::INFINITY);
+    }
+    assert!(full.build_stats.sah_cost < s.sah_cost);
+}
+
+/// A closed triangulated sphere with shared vertices (UV sphere).
+fn sphere(center: Vec3, radius: f32, rings: usize, segments: usize) -> Vec<[Vec3; 3]> {
+    let pole_n = center + Vec3::Y * radius;
+    let pole_s = center - Vec3::Y * radius;
+    let vert = |i: usize, j: usize| {
+        let th = std::f32::consts::PI * i as f32 / rings as f32;
+        let ph = 2.0 * std::f32::consts::PI * (j % segments) as f32 / segments as f32;
+        center + radius * Vec3::new(th.sin() * ph.cos(), th.cos(), th.sin() * ph.sin())
+    };
+    let mut tris = vec![];
+    for j in 0..segments {
+        tris.push([pole_n, vert(1, j + 1), vert(1, j)]);
+        tris.push([pole_s, vert(rings - 1, j), vert(rings - 1, j + 1)]);
+        for i in 1..rings - 1 {
+            let (a, b, c, d) = (
+                vert(i, j),
+                vert(i, j + 1),
+                vert(i + 1, j),
+                vert(i + 1, j + 1),
+            );
+            tris.push([a, b, d]);
+            tris.push([a, d, c]);
+        }
+    }
+    tris
+}
+
+#[test]
+fn closed_meshes_are_watertight() {
+    let mut r = rng(9);
+    for (center, radius) in [
+        (Vec3::ZERO, 1.0),
+        (Vec3::new(700.0, 300.0, -200.0), 250.0),
+        (Vec3::new(0.01, -0.02, 0.0), 0.003),
+    ] {
+        let tris = sphere(center, radius, 24, 48);
+        let bvh = Bvh::build_from_vertices(&tris);
+        check_structure(&bvh, &tris);
+        let mut aimed = 0;
+        for k in 0..20_000 {
+            let o = center + rand_vec(&mut r, -0.5, 0.5) * radius;
+            // Aim at vertices and edges of the mesh, where a leaky test lets rays out.
+            let d = match k % 3 {
+                0 => rand_dir(&mut r),
+                1 => {
+                    let t = tris[r.random_range(0..tris.len())];
+                    aimed += 1;
+                    t[r.random_range(0..3)] - o
+                }
+                _ => {
+                    let t = tris[r.random_range(0..tris.len())];
+                    let s: f32 = r.random_range(0.0..1.0);
+                    let e = r.random_range(0..3);
+                    aimed += 1;
+                    t[e] + s * (t[(e + 1) % 3] - t[e]) - o
+                }
+            };
+            assert!(
+                bvh.trace_any(o, d, f32::INFINITY),
+                "ray from {o} along {d} escaped the sphere at {center}"
+            );
+            assert!(bvh.trace_closest(o, d, f32::INFINITY).is_some());
+        }
+        assert!(aimed > 10_000);
+    }
+}
+
+#[test]
+fn axis_aligned_rays_in_a_box_room() {
+    // A closed axis-aligned box: rays along the axes (two zero direction components)
+    // from inside, also starting on the box's planes extended, must all hit a wall.
+    let (lo, hi) = (Vec3::new(-3.0, 0.0, -1.0), Vec3::new(5.0, 2.0, 4.0));
+    let c = |i: usize| {
+        Vec3::new(
+            if i & 1 == 0 { lo.x } else { hi.x },
+            if i & 2 == 0 { lo.y } else { hi.y },
+            if i & 4 == 0 { lo.z } else { hi.z },
+        )
+    };
+    let quads = [
+        [0, 1, 3, 2],
+        [4, 6, 7, 5],
+        [0, 4, 5, 1],
+        [2, 3, 7, 6],
+        [0, 2, 6, 4],
+        [1, 5, 7, 3],
+    ];
+    let mut tris = vec![];
+    for q in quads {
+        tris.push([c(q[0]), c(q[1]), c(q[2])]);
+        tris.push([c(q[0]), c(q[2]), c(q[3])]);
+    }
+    let bvh = Bvh::build_from_vertices(&tris);
+    let mut r = rng(10);
+    for k in 0..3000 {
+        let mut o = lo + (hi - lo) * rand_vec(&mut r, 0.0, 1.0);
+        if k % 4 == 0 {
+            o.x = 1.0; // a plane through a diagonal of no wall, and the box's middle
+        }
+        for d in [
+            Vec3::X,
+            Vec3::NEG_X,
+            Vec3::Y,
+            Vec3::NEG_Y,
+            Vec3::Z,
+            Vec3::NEG_Z,
+        ] {
+            assert!(bvh.trace_any(o, d, f32::INFINITY), "{o} {d}");
+            check_ray(&bvh, &tris, o, d, f32::INFINITY);
+        }
+        // Origins on a wall's plane, rays running inside that plane: the wall itself is
+        // parallel (no hit), so only the edges of the walls across can stop them. The
+        // walls' boxes are flat and the origin lies on their planes: the parallel-axis
+        // case of the slab test.
+        let axis = k % 3;
+        o[axis] = if k % 2 == 0 { lo[axis] } else { hi[axis] };
+        for d in [
+            Vec3::X,
+            Vec3::NEG_X,
+            Vec3::Y,
+            Vec3::NEG_Y,
+            Vec3::Z,
+            Vec3::NEG_Z,
+        ] {
+            if d[axis] != 0.0 {
+                continue;
+            }
+            assert!(bvh.trace_any(o, d, f32::INFINITY), "in-plane {o} {d}");
+            check_ray(&bvh, &tris, o, d, f32::INFINITY);
+        }
+    }
+}
+
+/// A random point on a triangle by barycentrics, as a renderer computes hit points.
+fn point_on(r: &mut Pcg64, t: &[Vec3; 3]) -> Vec3 {
+    let mut u: f32 = r.random_range(0.0..1.0);
+    let mut v: f32 = r.random_range(0.0..1.0);
+    if u + v > 1.0 {
+        (u, v) = (1.0 - u, 1.0 - v);
+    }
+    t[0] * (1.0 - u - v) + t[1] * u + t[2] * v
+}
+
+/// A direction in the hemisphere around n, cosine at least `min_cos`.
+fn hemisphere(r: &mut Pcg64, n: Vec3, min_cos: f32) -> Vec3 {
+    loop {
+        let d = rand_dir(r);
+        let c = d.dot(n);
+        if c >= min_cos {
+            return d;
+        }
+        if -c >= min_cos {
+            return -d;
+        }
+    }
+}
+
+#[test]
+fn offset_origin_never_hits_its_own_triangle() {
+    let mut r = rng(11);
+    let mut grazing = 0;
+    // (where the triangles are, how big they are): tiny near the origin, unit, the
+    // conference room (~1000 units, triangles up to a wall's size), far from the origin.
+    for (extent, size) in [
+        (1e-3f32, 1e-3f32),
+        (0.02, 0.01),
+        (1.0, 0.5),
+        (1000.0, 1.0),
+        (1000.0, 300.0),
+        (1.0e5, 50.0),
+    ] {
+        for _ in 0..2000 {
+            let c = rand_vec(&mut r, -extent, extent);
+            let t = [
+                c + rand_vec(&mut r, -size, size),
+                c + rand_vec(&mut r, -size, size),
+                c + rand_vec(&mut r, -size, size),
+            ];
+            let n = (t[1] - t[0]).cross(t[2] - t[0]);
+            if n.length() < 1e-3 * size * size {
+                continue; // a sliver: its normal is meaningless
+            }
+            let n = n.normalize();
+            for _ in 0..10 {
+                let p = point_on(&mut r, &t);
+                for side in [n, -n] {
+                    let o = offset_ray_origin(p, side);
+                    // Directions down to 1 degree above the surface.
+                    let d = hemisphere(&mut r, side, 0.02);
+                    grazing += usize::from(d.dot(side) < 0.1);
+                    assert!(
+                        brute_force_closest(&[t], o, d, f32::INFINITY).is_none(),
+                        "self-hit: triangle {t:?}, p {p}, n {side}, o {o}, d {d}"
+                    );
+                }
+            }
+        }
+    }
+    assert!(grazing > 1000);
+}
+
+#[test]
+fn segments_between_facing_planes_are_unoccluded() {
+    let mut r = rng(12);
+    for (extent, size, gap) in [
+        (1e-3f32, 1e-2f32, 1e-3f32),
+        (1.0, 2.0, 0.01),
+        (1.0, 2.0, 1.0),
+        (1000.0, 1000.0, 1.0),
+        (1000.0, 1000.0, 500.0),
+        (1.0e4, 2000.0, 10.0),
+    ] {
+        for _ in 0..50 {
+            // Two parallel planes (quads of two triangles), at random orientation.
+            let n = rand_dir(&mut r);
+            let u = n.any_orthonormal_vector();
+            let w = n.cross(u);
+            let c = rand_vec(&mut r, -extent, extent);
+            let quad = |o: Vec3| {
+                let p = |a: f32, b: f32| o + size * (a * u + b * w);
+                let (p00, p10, p11, p01) = (p(-1.0, -1.0), p(1.0, -1.0), p(1.0, 1.0), p(-1.0, 1.0));
+                [[p00, p10, p11], [p00, p11, p01]]
+            };
+            let q1 = quad(c);
+            let q2 = quad(c + gap * n);
+            let tris: Vec<[Vec3; 3]> = q1.iter().chain(q2.iter()).copied().collect();
+            let bvh = Bvh::build_from_vertices(&tris);
+            // The normals as a renderer has them: from the triangles' own vertices.
+            let normal = |t: &[Vec3; 3]| (t[1] - t[0]).cross(t[2] - t[0]).normalize();
+            for _ in 0..200 {
+                let t1 = &q1[r.random_range(0..2)];
+                let t2 = &q2[r.random_range(0..2)];
+                let x = point_on(&mut r, t1);
+                let y = point_on(&mut r, t2);
+                let (o, d) = shadow_segment(x, normal(t1), y, normal(t2));
+                assert!(
+                    !bvh.trace_any(o, d, 1.0),
+                    "segment {x} -> {y} occluded (gap {gap}, size {size})"
+                );
+                let (o, d) = shadow_segment(y, normal(t2), x, normal(t1));
+                assert!(!bvh.trace_any(o, d, 1.0), "segment {y} -> {x} occluded");
+                // A segment that goes on beyond the far plane must be occluded by it.
+                // Aimed at the inner half of the far quad: the offset of x shifts where a
+                // grazing segment crosses it by up to offset * length / gap.
+                let yc = c + gap * n + 0.5 * (y - c - gap * n);
+                let (o, d) = shadow_segment(x, normal(t1), yc + (yc - x), normal(t2));
+                assert!(
+                    bvh.trace_any(o, d, 1.0),
+                    "segment {x} -> {} through the far plane missed it (gap {gap}, size {size})",
+                    yc + (yc - x)
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn parallel_build_is_deterministic_and_correct() {
+    // Large enough for the threaded top levels.
+    let mut r = rng(13);
+    let tris = random_triangles(&mut r, 60_000, 100.0, 1.5);
+    let a = Bvh::build_from_vertices(&tris);
+    let b = Bvh::build_from_vertices(&tris);
+    assert_eq!(a.nodes, b.nodes);
+    assert_eq!(a.tri_order, b.tri_order);
+    check_structure(&a, &tris);
+    for _ in 0..300 {
+        let o = rand_vec(&mut r, -120.0, 120.0);
+        let d = rand_dir(&mut r);
+        check_ray(&a, &tris, o, d, f32::INFINITY);
+    }
+}
+

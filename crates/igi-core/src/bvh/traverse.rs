@@ -1,0 +1,438 @@
+//! CPU traversal, the twin of `traverse.wgsl`: same ray setup, same box and triangle tests,
+//! same visiting order, so that the CPU answers what the GPU answers (up to the rounding of
+//! division, which WGSL allows to be 2.5 ulp, and of fused multiply-adds, which GPU
+//! compilers may form; see the notes on each test).
+
+use bytemuck::{Pod, Zeroable};
+use glam::Vec3;
+
+use super::{Bvh, MAX_DEPTH};
+
+/// `Hit::tri` of a miss on the GPU (the CPU returns `None`).
+pub const NO_HIT: u32 = 0xffff_ffff;
+
+/// Direction components smaller than this in magnitude count as zero for the box test:
+/// the ray is parallel to that slab ("parallel axis").
+///
+/// WGSL leaves the result of operations on infinities and NaNs indeterminate, so the IEEE
+/// trick of an infinite reciprocal (and the 0 * inf = NaN it gives for an origin on a
+/// slab plane, which pbrt's comparison order ignores) cannot be relied on in the shader.
+/// A parallel axis gets the finite reciprocal [`PARALLEL_INV`] instead: its entry
+/// distance (min - o) * 1e30 is <= 0 inside the slab and, outside it, a distance beyond
+/// any real one unless the origin is within ~1e-23 of the plane (then the box is merely
+/// visited for nothing: conservative). Its exit distance (max - o) * 1e30 would be 0 for
+/// an origin on the max plane, where the ray runs inside the closed slab: any exit
+/// distance >= 0 of a parallel axis is therefore replaced by [`FAR_BIG`]. No NaN or
+/// infinity arises from finite data (coordinates up to ~1e7).
+///
+/// A component below 1e-30 that is not exactly 0 moves the ray by less than 1e-30 t along
+/// its axis; treating it as 0 can only matter for an origin within 1e-23 of a box plane.
+pub(crate) const DIR_EPS: f32 = 1e-30;
+/// Reciprocal used for parallel axes (see [`DIR_EPS`]).
+pub(crate) const PARALLEL_INV: f32 = 1e30;
+/// "Never leaves the slab": the exit distance of a parallel axis the ray lies inside.
+/// Finite, and small enough that BOX_TFAR_SCALE * FAR_BIG stays finite.
+pub(crate) const FAR_BIG: f32 = 1e38;
+
+/// Conservative rounding factor for the far end of a slab: 1 + 2 gamma(3) with
+/// gamma(n) = n eps / (1 - n eps), eps = 2^-24 (pbrt-v3/v4 `Bounds3::IntersectP`, Ize
+/// 2013). The slab distances (b - o) * inv carry three roundings (subtraction, reciprocal,
+/// product), so scaling t_far by this factor keeps every box the exact arithmetic would
+/// hit. The literal is 1 + 3 ulp(1), the f32 nearest to 1 + 2 gamma(3) = 1.00000036.
+/// The bound assumes a correctly rounded reciprocal (CPU, lavapipe); WGSL allows 2.5 ulp
+/// for division, which would need 1 + 2 gamma(7) to be strictly covered.
+pub(crate) const BOX_TFAR_SCALE: f32 = 1.000_000_357_627_868_7;
+
+/// Wächter-Binder offset: distance below which coordinates get an absolute offset.
+const OFFSET_ORIGIN: f32 = 1.0 / 32.0;
+/// Wächter-Binder offset: absolute offset (times the normal) near the origin.
+const OFFSET_FLOAT_SCALE: f32 = 1.0 / 65536.0;
+/// Wächter-Binder offset: ulps (times the normal) added to the bits of each coordinate.
+const OFFSET_INT_SCALE: f32 = 256.0;
+
+/// A hit of the BVH traversal; `#[repr(C)]` like `struct Hit` of `traverse.wgsl`
+/// (t: bytes 0..4, tri: 4..8, u: 8..12, v: 12..16).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct Hit {
+    /// Ray parameter: the hit point is origin + t dir.
+    pub t: f32,
+    /// BVH slot of the triangle ([`Bvh::tri_order`] maps it to the input index).
+    pub tri: u32,
+    /// Barycentric coordinate of vertex 1 (v[1]) at the hit point.
+    pub u: f32,
+    /// Barycentric coordinate of vertex 2 (v[2]); vertex 0 has 1 - u - v.
+    pub v: f32,
+}
+
+/// Per-ray data, computed once (`make_ray` in WGSL).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct TraceRay {
+    origin: Vec3,
+    inv_dir: Vec3,
+    /// Per axis: whether inv_dir < 0 (then the slab is entered at the box maximum).
+    neg: [bool; 3],
+    /// Per axis: |dir| < DIR_EPS, the ray is parallel to the slab.
+    parallel: [bool; 3],
+    /// Woop et al.: kz is the axis of the largest |dir| component, (kx, ky) the other two
+    /// in an order that keeps the triangles' winding.
+    kx: usize,
+    ky: usize,
+    kz: usize,
+    /// Shear constants (Sx, Sy, Sz) = (dir[kx] / dir[kz], dir[ky] / dir[kz], 1 / dir[kz]).
+    shear: Vec3,
+}
+
+impl TraceRay {
+    /// None for a zero direction (such a ray hits nothing).
+    pub(crate) fn new(origin: Vec3, dir: Vec3) -> Option<TraceRay> {
+        if dir.x == 0.0 && dir.y == 0.0 && dir.z == 0.0 {
+            return None;
+        }
+        let parallel = [0, 1, 2].map(|k| dir[k].abs() < DIR_EPS);
+        let inv = |k: usize| {
+            if parallel[k] {
+                PARALLEL_INV
+            } else {
+                1.0 / dir[k]
+            }
+        };
+        let inv_dir = Vec3::new(inv(0), inv(1), inv(2));
+        let a = dir.abs();
+        // Ties go to the lower axis; the WGSL uses the same comparisons.
+        let mut kz = 0;
+        if a.y > a.x {
+            kz = 1;
+        }
+        if a.z > a[kz] {
+            kz = 2;
+        }
+        let mut kx = (kz + 1) % 3;
+        let mut ky = (kx + 1) % 3;
+        if dir[kz] < 0.0 {
+            std::mem::swap(&mut kx, &mut ky);
+        }
+        let shear = Vec3::new(dir[kx] / dir[kz], dir[ky] / dir[kz], 1.0 / dir[kz]);
+        Some(TraceRay {
+            origin,
+            inv_dir,
+            neg: [inv_dir.x < 0.0, inv_dir.y < 0.0, inv_dir.z < 0.0],
+            parallel,
+            kx,
+            ky,
+            kz,
+            shear,
+        })
+    }
+}
+
+/// Slab test. Returns the entry distance (>= 0) when the box is hit within [0, tmax],
+/// -1 otherwise. The entry plane of each axis is chosen by the sign of the direction
+/// (not by min/max of both planes), so an inverted empty box (min = +inf, max = -inf)
+/// enters at +inf and leaves at -inf: never hit.
+#[inline]
+fn box_near(min: [f32; 3], max: [f32; 3], r: &TraceRay, tmax: f32) -> f32 {
+    let t0 = (Vec3::from(min) - r.origin) * r.inv_dir;
+    let t1 = (Vec3::from(max) - r.origin) * r.inv_dir;
+    let pick = |k: usize| {
+        let (near, far) = if r.neg[k] {
+            (t1[k], t0[k])
+        } else {
+            (t0[k], t1[k])
+        };
+        // A parallel axis the origin lies inside (or on a plane of) never exits.
+        let far = if r.parallel[k] && far >= 0.0 {
+            FAR_BIG
+        } else {
+            far
+        };
+        (near, far)
+    };
+    let (nx, fx) = pick(0);
+    let (ny, fy) = pick(1);
+    let (nz, fz) = pick(2);
+    let near = nx.max(ny).max(nz.max(0.0));
+    let far = (fx.min(fy).min(fz) * BOX_TFAR_SCALE).min(tmax);
+    if near <= far {
+        near
+    } else {
+        -1.0
+    }
+}
+
+/// Watertight ray-triangle test (Woop, Benthin, Wald, JCGT 2(1), 2013), two-sided.
+/// Returns (t, u, v) for a hit with 0 < t < tmax; u, v weigh v1 and v2.
+///
+/// Watertight: the vertices are translated to the ray origin and sheared so that the ray
+/// becomes the +z axis; a shared vertex gets the same 2D coordinates in every triangle,
+/// and the edge functions of a shared edge are the same two rounded products compared in
+/// opposite order. Rounding is monotone, so a product comparison never inverts the exact
+/// sign; it can only turn it into a tie, and ties (edge and vertex hits) count as hits.
+/// Hence a ray through a shared edge or vertex hits at least one of the triangles (it
+/// may hit both: a double hit, never a leak).
+///
+/// The signs are taken from comparisons of the products instead of the sign of their
+/// difference because a GPU compiler may fuse `p1 - p2` into fma(a, b, -p2), whose sign
+/// can disagree with the neighbour's. The paper's double-precision re-test of zero edge
+/// functions is omitted: it only decides exact ties, turning the possible double hit at
+/// an edge into a single one; without it a ray may count as hitting a triangle it misses
+/// by one rounding of the 2D products (a relative ~1e-7 of the triangle's extent seen
+/// from the origin), which no pass of igi can tell apart.
+#[inline]
+fn intersect_triangle(
+    r: &TraceRay,
+    v0: Vec3,
+    v1: Vec3,
+    v2: Vec3,
+    tmax: f32,
+) -> Option<(f32, f32, f32)> {
+    let a = v0 - r.origin;
+    let b = v1 - r.origin;
+    let c = v2 - r.origin;
+    let (kx, ky, kz) = (r.kx, r.ky, r.kz);
+    let (sx, sy, sz) = (r.shear.x, r.shear.y, r.shear.z);
+    let ax = a[kx] - sx * a[kz];
+    let ay = a[ky] - sy * a[kz];
+    let bx = b[kx] - sx * b[kz];
+    let by = b[ky] - sy * b[kz];
+    let cx = c[kx] - sx * c[kz];
+    let cy = c[ky] - sy * c[kz];
+    // Edge functions U = cx by - cy bx (weight of v0), V (v1), W (v2), as product pairs.
+    let (u1, u2) = (cx * by, cy * bx);
+    let (v1_, v2_) = (ax * cy, ay * cx);
+    let (w1, w2) = (bx * ay, by * ax);
+    let inside = (u1 >= u2 && v1_ >= v2_ && w1 >= w2) || (u1 <= u2 && v1_ <= v2_ && w1 <= w2);
+    if !inside {
+        return None;
+    }
+    let uu = u1 - u2;
+    let vv = v1_ - v2_;
+    let ww = w1 - w2;
+    let det = uu + vv + ww;
+    if det == 0.0 {
+        return None; // the ray lies in the triangle's plane, or the triangle is degenerate
+    }
+    let az = sz * a[kz];
+    let bz = sz * b[kz];
+    let cz = sz * c[kz];
+    let tt = uu * az + vv * bz + ww * cz;
+    let rcp = 1.0 / det;
+    let t = tt * rcp;
+    if t > 0.0 && t < tmax {
+        Some((t, vv * rcp, ww * rcp))
+    } else {
+        None
+    }
+}
+
+#[inline]
+fn slot_vertices(bvh: &Bvh, slot: u32) -> (Vec3, Vec3, Vec3) {
+    let i = 3 * slot as usize;
+    let v = |k: usize| {
+        let p = bvh.tri_verts[k];
+        Vec3::new(p[0], p[1], p[2])
+    };
+    (v(i), v(i + 1), v(i + 2))
+}
+
+/// Tests the triangles of a leaf in slot order; keeps the first of equal-distance hits.
+#[inline]
+fn leaf_closest(bvh: &Bvh, first: u32, count: u32, r: &TraceRay, hit: &mut Hit) {
+    for slot in first..first + count {
+        let (v0, v1, v2) = slot_vertices(bvh, slot);
+        if let Some((t, u, v)) = intersect_triangle(r, v0, v1, v2, hit.t) {
+            *hit = Hit { t, tri: slot, u, v };
+        }
+    }
+}
+
+#[inline]
+fn leaf_any(bvh: &Bvh, first: u32, count: u32, r: &TraceRay, tmax: f32) -> bool {
+    (first..first + count).any(|slot| {
+        let (v0, v1, v2) = slot_vertices(bvh, slot);
+        intersect_triangle(r, v0, v1, v2, tmax).is_some()
+    })
+}
+
+/// The two children of a node, nearer first (ties: child a first); a missed child has
+/// distance -1 and goes second.
+#[inline]
+fn ordered(node: &super::BvhNode, r: &TraceRay, tmax: f32) -> [(f32, u32, u32); 2] {
+    let ta = box_near(node.a_min, node.a_max, r, tmax);
+    let tb = box_near(node.b_min, node.b_max, r, tmax);
+    let a = (ta, node.a_index, node.a_count);
+    let b = (tb, node.b_index, node.b_count);
+    if tb >= 0.0 && (ta < 0.0 || tb < ta) {
+        [b, a]
+    } else {
+        [a, b]
+    }
+}
+
+/// Closest hit: visits the nearer child first; leaf children are tested as soon as their
+/// box is hit, interior ones are descended into (the nearer) or pushed (the farther).
+/// Boxes are tested against the current closest t, so hits found prune the rest.
+pub(crate) fn trace_closest(bvh: &Bvh, origin: Vec3, dir: Vec3, tmax: f32) -> Option<Hit> {
+    let r = TraceRay::new(origin, dir)?;
+    let mut hit = Hit {
+        t: tmax,
+        tri: NO_HIT,
+        u: 0.0,
+        v: 0.0,
+    };
+    let mut stack = [0u32; MAX_DEPTH as usize];
+    let mut sp = 0usize;
+    let mut node = 0u32;
+    loop {
+        let n = &bvh.nodes[node as usize];
+        let [c0, c1] = ordered(n, &r, hit.t);
+        let mut next = NO_HIT;
+        if c0.0 >= 0.0 {
+            if c0.2 > 0 {
+                leaf_closest(bvh, c0.1, c0.2, &r, &mut hit);
+            } else {
+                next = c0.1;
+            }
+        }
+        // Re-check the far child: a leaf of the near child may have moved hit.t closer.
+        if c1.0 >= 0.0 && c1.0 <= hit.t {
+            if c1.2 > 0 {
+                leaf_closest(bvh, c1.1, c1.2, &r, &mut hit);
+            } else if next == NO_HIT {
+                next = c1.1;
+            } else {
+                stack[sp] = c1.1;
+                sp += 1;
+            }
+        }
+        if next == NO_HIT {
+            if sp == 0 {
+                break;
+            }
+            sp -= 1;
+            next = stack[sp];
+        }
+        node = next;
+    }
+    (hit.tri != NO_HIT).then_some(hit)
+}
+
+/// Any hit: the same walk as [`trace_closest`] without pruning, returning at the first
+/// triangle hit with 0 < t < tmax.
+pub(crate) fn trace_any(bvh: &Bvh, origin: Vec3, dir: Vec3, tmax: f32) -> bool {
+    let Some(r) = TraceRay::new(origin, dir) else {
+        return false;
+    };
+    let mut stack = [0u32; MAX_DEPTH as usize];
+    let mut sp = 0usize;
+    let mut node = 0u32;
+    loop {
+        let n = &bvh.nodes[node as usize];
+        let [c0, c1] = ordered(n, &r, tmax);
+        let mut next = NO_HIT;
+        if c0.0 >= 0.0 {
+            if c0.2 > 0 {
+                if leaf_any(bvh, c0.1, c0.2, &r, tmax) {
+                    return true;
+                }
+            } else {
+                next = c0.1;
+            }
+        }
+        if c1.0 >= 0.0 {
+            if c1.2 > 0 {
+                if leaf_any(bvh, c1.1, c1.2, &r, tmax) {
+                    return true;
+                }
+            } else if next == NO_HIT {
+                next = c1.1;
+            } else {
+                stack[sp] = c1.1;
+                sp += 1;
+            }
+        }
+        if next == NO_HIT {
+            if sp == 0 {
+                return false;
+            }
+            sp -= 1;
+            next = stack[sp];
+        }
+        node = next;
+    }
+}
+
+/// Closest hit over all triangles with the same triangle test as the BVH (the reference
+/// of the tests): (index, t) of the first triangle, in slice order, at the smallest t in
+/// (0, tmax).
+pub fn brute_force_closest(
+    triangles: &[[Vec3; 3]],
+    origin: Vec3,
+    dir: Vec3,
+    tmax: f32,
+) -> Option<(u32, f32)> {
+    let r = TraceRay::new(origin, dir)?;
+    let mut best = None;
+    let mut t_best = tmax;
+    for (i, [v0, v1, v2]) in triangles.iter().enumerate() {
+        if let Some((t, _, _)) = intersect_triangle(&r, *v0, *v1, *v2, t_best) {
+            best = Some((i as u32, t));
+            t_best = t;
+        }
+    }
+    best
+}
+
+/// Whether any triangle is hit with 0 < t < tmax, with the BVH's triangle test.
+pub fn brute_force_any(triangles: &[[Vec3; 3]], origin: Vec3, dir: Vec3, tmax: f32) -> bool {
+    let Some(r) = TraceRay::new(origin, dir) else {
+        return false;
+    };
+    triangles
+        .iter()
+        .any(|[v0, v1, v2]| intersect_triangle(&r, *v0, *v1, *v2, tmax).is_some())
+}
+
+/// Origin for a ray leaving a surface at `p` (Wächter and Binder, "A Fast and Robust
+/// Method for Avoiding Self-Intersection", Ray Tracing Gems, ch. 6).
+///
+/// `n` is the unit geometric normal on the side the ray leaves to (flip it for rays
+/// going into the other side). Each coordinate moves along n by 256 n_i ulps of itself
+/// (integer arithmetic on its bits), so the offset grows with the coordinate's magnitude
+/// like the rounding error of the hit point does; coordinates within 1/32 of 0, whose
+/// ulps are too small, move by n_i / 65536 instead. The bits match `offset_ray_origin`
+/// of `traverse.wgsl` exactly (truncating f32 -> i32 conversion, wrapping i32 add).
+///
+/// Its limit: the offset scales with the hit point, not with the triangle's vertices, so
+/// a point whose coordinate is much smaller than those of the vertices it was
+/// interpolated from (a huge triangle passing near the world origin) carries more error
+/// than the offset covers.
+pub fn offset_ray_origin(p: Vec3, n: Vec3) -> Vec3 {
+    let f = |p: f32, n: f32| {
+        if p.abs() < OFFSET_ORIGIN {
+            p + OFFSET_FLOAT_SCALE * n
+        } else {
+            let of = (OFFSET_INT_SCALE * n) as i32;
+            let of = if p < 0.0 { of.wrapping_neg() } else { of };
+            f32::from_bits((p.to_bits() as i32).wrapping_add(of) as u32)
+        }
+    };
+    Vec3::new(f(p.x, n.x), f(p.y, n.y), f(p.z, n.z))
+}
+
+/// The shadow ray of the segment from surface point `x` (geometric normal `nx`) to
+/// surface point `y` (normal `ny`): returns (origin, dir) to trace with tmax = 1.
+///
+/// Both ends are offset with [`offset_ray_origin`], each along its normal flipped to face
+/// the other point, so that neither surface occludes the segment. The direction is
+/// y' - x', not normalised: t is in units of the segment (t = 1 at y'), which is why
+/// tmax = 1 and why the caller needs no distance. Normals need not be oriented.
+pub fn shadow_segment(x: Vec3, nx: Vec3, y: Vec3, ny: Vec3) -> (Vec3, Vec3) {
+    let d = y - x;
+    let nx = if nx.dot(d) < 0.0 { -nx } else { nx };
+    let ny = if ny.dot(d) > 0.0 { -ny } else { ny };
+    let o = offset_ray_origin(x, nx);
+    let e = offset_ray_origin(y, ny);
+    (o, e - o)
+}
+

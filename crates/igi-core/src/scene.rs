@@ -1,0 +1,115 @@
+//! The scene as the renderer sees it: flat triangles with materials, point lights and a
+//! pinhole camera (paper section 4: the paper's only light type is the point light).
+//!
+//! Loading lives in [`loader`] (the TOML contract and OBJ/MTL), the built-in Cornell box
+//! in [`builtin`].
+
+pub mod builtin;
+pub mod gltf;
+pub mod loader;
+
+use glam::Vec3;
+use std::path::PathBuf;
+
+pub use loader::{load_scene, SceneError};
+
+/// A pinhole camera, as `[camera]` in the scene file.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Camera {
+    pub eye: Vec3,
+    pub target: Vec3,
+    pub up: Vec3,
+    pub fov_y_deg: f32,
+}
+
+/// The default image size, as `[film]` in the scene file.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Film {
+    pub width: u32,
+    pub height: u32,
+}
+
+/// Lambertian albedo plus a perfect mirror; `diffuse + mirror <= 1` per channel.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Material {
+    pub name: String,
+    pub diffuse: Vec3,
+    pub mirror: Vec3,
+}
+
+/// A point light of radiant intensity `intensity` (W/sr, RGB); total power 4 pi I.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PointLight {
+    pub position: Vec3,
+    pub intensity: Vec3,
+}
+
+impl PointLight {
+    /// Total emitted power (flux), 4 pi I per channel.
+    pub fn power(&self) -> Vec3 {
+        4.0 * std::f32::consts::PI * self.intensity
+    }
+}
+
+/// One triangle of the scene. Surfaces are two-sided.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Triangle {
+    /// Vertex positions, in the order of the file (fans of polygons keep the winding).
+    pub v: [Vec3; 3],
+    /// Unit shading normals at the vertices: the OBJ's `vn` where present, otherwise the
+    /// geometric normal repeated three times.
+    pub n: [Vec3; 3],
+    /// Index into [`Scene::materials`].
+    pub material: u32,
+}
+
+impl Triangle {
+    /// Unnormalised geometric normal (v1 - v0) x (v2 - v0); its length is twice the area.
+    pub fn cross(&self) -> Vec3 {
+        (self.v[1] - self.v[0]).cross(self.v[2] - self.v[0])
+    }
+    pub fn area(&self) -> f32 {
+        0.5 * self.cross().length()
+    }
+}
+
+/// A loaded scene, ready for the BVH build and the GPU upload.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    pub camera: Camera,
+    pub film: Film,
+    pub triangles: Vec<Triangle>,
+    pub materials: Vec<Material>,
+    pub lights: Vec<PointLight>,
+    /// Where the scene came from (a file, or `builtin:NAME`), for messages and reports.
+    pub source: String,
+    /// Files the scene was read from (the TOML and its meshes), for reports.
+    pub files: Vec<PathBuf>,
+}
+
+impl Scene {
+    /// Axis-aligned bounds of all triangles (min, max).
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        let mut lo = Vec3::splat(f32::INFINITY);
+        let mut hi = Vec3::splat(f32::NEG_INFINITY);
+        for t in &self.triangles {
+            for v in t.v {
+                lo = lo.min(v);
+                hi = hi.max(v);
+            }
+        }
+        (lo, hi)
+    }
+
+    /// Length of the diagonal of the bounds: the scene's size, used for default
+    /// distances (the bounding distance of G, ray offsets).
+    pub fn diagonal(&self) -> f32 {
+        let (lo, hi) = self.bounds();
+        (hi - lo).length()
+    }
+
+    /// Total power of all lights (RGB).
+    pub fn total_power(&self) -> Vec3 {
+        self.lights.iter().map(|l| l.power()).sum()
+    }
+}

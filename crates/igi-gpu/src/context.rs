@@ -1,0 +1,283 @@
+//! The wgpu instance, adapter choice and device: the one place that decides which GPU igi
+//! runs on (a real GPU when there is one, Mesa's software Vulkan adapter otherwise).
+
+use std::sync::{Arc, Mutex};
+
+/// Errors of the GPU layer, each one line for the user.
+#[derive(Debug, thiserror::Error)]
+pub enum GpuError {
+    #[error("no GPU adapter found: install a Vulkan driver (on Debian/Ubuntu the software one: `apt-get install mesa-vulkan-drivers`)")]
+    NoAdapter,
+    #[error("no adapter matches '{0}' (run `igi info` to list them)")]
+    AdapterNotFound(String),
+    #[error("could not open the GPU device on '{adapter}': {reason}")]
+    RequestDevice { adapter: String, reason: String },
+    #[error("GPU error: {0}")]
+    Device(String),
+    #[error("{0}")]
+    Limit(String),
+}
+
+/// VPL range of one gathering dispatch on a software adapter (see
+/// [`GpuContext::vpls_per_dispatch`]): 8 traversals stay well inside llvmpipe's budget
+/// even for long shadow rays through the 277K-triangle conference room.
+pub const SOFTWARE_VPLS_PER_DISPATCH: u32 = 8;
+
+/// Which adapter to use: the best one, or one named by index or by part of its name.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub enum AdapterChoice {
+    #[default]
+    Best,
+    /// Index in the list of `igi info`, or a case-insensitive part of the adapter name.
+    Named(String),
+}
+
+impl AdapterChoice {
+    pub fn from_option(s: Option<&str>) -> Self {
+        match s {
+            None => AdapterChoice::Best,
+            Some(s) => AdapterChoice::Named(s.to_string()),
+        }
+    }
+}
+
+/// One line per adapter for `igi info`.
+#[derive(Clone, Debug)]
+pub struct AdapterSummary {
+    pub index: usize,
+    pub name: String,
+    pub backend: String,
+    pub device_type: String,
+    pub driver: String,
+    pub timestamps: bool,
+}
+
+/// The device in use, with what igi needs to know about it.
+pub struct GpuContext {
+    pub adapter: wgpu::Adapter,
+    pub device: wgpu::Device,
+    pub queue: wgpu::Queue,
+    pub info: wgpu::AdapterInfo,
+    /// Whether GPU timestamp queries (per-stage timings) are available.
+    pub timestamps: bool,
+    /// The first uncaptured error (validation, out of memory) seen on the device, if any.
+    errors: Arc<Mutex<Option<String>>>,
+}
+
+fn instance() -> wgpu::Instance {
+    wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env())
+}
+
+/// Rank adapters so that a real GPU beats a software one.
+fn preference(info: &wgpu::AdapterInfo) -> u32 {
+    use wgpu::DeviceType::*;
+    let ty = match info.device_type {
+        DiscreteGpu => 4,
+        IntegratedGpu => 3,
+        VirtualGpu => 2,
+        Other => 1,
+        Cpu => 0,
+    };
+    // Vulkan first: it is the backend igi is measured and tested on.
+    let backend = u32::from(info.backend == wgpu::Backend::Vulkan);
+    ty * 2 + backend
+}
+
+fn adapters() -> Vec<wgpu::Adapter> {
+    pollster::block_on(instance().enumerate_adapters(wgpu::Backends::all()))
+        .into_iter()
+        // A compute-only renderer needs compute shaders and storage buffers: GL ES without
+        // them is of no use.
+        .filter(|a| {
+            a.get_downlevel_capabilities()
+                .flags
+                .contains(wgpu::DownlevelFlags::COMPUTE_SHADERS)
+        })
+        .collect()
+}
+
+/// The adapters wgpu sees, and the index of the one [`AdapterChoice::Best`] would pick.
+pub fn list_adapters() -> (Vec<AdapterSummary>, Option<usize>) {
+    let adapters = adapters();
+    let list: Vec<AdapterSummary> = adapters
+        .iter()
+        .enumerate()
+        .map(|(index, a)| {
+            let info = a.get_info();
+            AdapterSummary {
+                index,
+                name: info.name.clone(),
+                backend: format!("{:?}", info.backend),
+                device_type: format!("{:?}", info.device_type),
+                driver: format!("{} {}", info.driver, info.driver_info)
+                    .trim()
+                    .to_string(),
+                timestamps: a.features().contains(wgpu::Features::TIMESTAMP_QUERY),
+            }
+        })
+        .collect();
+    let best = pick(&adapters, &AdapterChoice::Best).ok();
+    (list, best)
+}
+
+fn pick(adapters: &[wgpu::Adapter], choice: &AdapterChoice) -> Result<usize, GpuError> {
+    if adapters.is_empty() {
+        return Err(GpuError::NoAdapter);
+    }
+    match choice {
+        AdapterChoice::Best => Ok((0..adapters.len())
+            .max_by_key(|&i| (preference(&adapters[i].get_info()), usize::MAX - i))
+            .expect("non-empty")),
+        AdapterChoice::Named(name) => {
+            if let Ok(i) = name.parse::<usize>() {
+                return if i < adapters.len() {
+                    Ok(i)
+                } else {
+                    Err(GpuError::AdapterNotFound(name.clone()))
+                };
+            }
+            let lower = name.to_lowercase();
+            adapters
+                .iter()
+                .position(|a| a.get_info().name.to_lowercase().contains(&lower))
+                .ok_or_else(|| GpuError::AdapterNotFound(name.clone()))
+        }
+    }
+}
+
+impl GpuContext {
+    /// Open the device of the chosen adapter, with timestamp queries when it has them and
+    /// the adapter's own limits (large scenes need its full storage-buffer size).
+    pub fn new(choice: &AdapterChoice) -> Result<GpuContext, GpuError> {
+        let mut adapters = adapters();
+        let index = pick(&adapters, choice)?;
+        let adapter = adapters.swap_remove(index);
+        let info = adapter.get_info();
+        let timestamps = adapter.features().contains(wgpu::Features::TIMESTAMP_QUERY);
+        let mut features = wgpu::Features::empty();
+        if timestamps {
+            features |= wgpu::Features::TIMESTAMP_QUERY;
+        }
+        let desc = wgpu::DeviceDescriptor {
+            label: Some("igi"),
+            required_features: features,
+            required_limits: adapter.limits(),
+            experimental_features: wgpu::ExperimentalFeatures::disabled(),
+            memory_hints: wgpu::MemoryHints::Performance,
+            trace: wgpu::Trace::Off,
+        };
+        let (device, queue) = pollster::block_on(adapter.request_device(&desc)).map_err(|e| {
+            GpuError::RequestDevice {
+                adapter: info.name.clone(),
+                reason: e.to_string(),
+            }
+        })?;
+        let errors: Arc<Mutex<Option<String>>> = Arc::default();
+        let sink = errors.clone();
+        device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
+            let mut slot = sink.lock().unwrap_or_else(|p| p.into_inner());
+            if slot.is_none() {
+                *slot = Some(one_line(&e.to_string()));
+            }
+        }));
+        let sink = errors.clone();
+        device.set_device_lost_callback(move |reason, message| {
+            let mut slot = sink.lock().unwrap_or_else(|p| p.into_inner());
+            if slot.is_none() {
+                *slot = Some(format!("device lost ({reason:?}): {}", one_line(&message)));
+            }
+        });
+        Ok(GpuContext {
+            adapter,
+            device,
+            queue,
+            info,
+            timestamps,
+            errors,
+        })
+    }
+
+    /// Wait for all submitted work, then report the first device error seen, if any.
+    pub fn finish(&self) -> Result<(), GpuError> {
+        self.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| GpuError::Device(e.to_string()))?;
+        self.check()
+    }
+
+    /// The first uncaptured device error, if one happened.
+    pub fn check(&self) -> Result<(), GpuError> {
+        let slot = self.errors.lock().unwrap_or_else(|p| p.into_inner());
+        match slot.as_ref() {
+            Some(e) => Err(GpuError::Device(e.clone())),
+            None => Ok(()),
+        }
+    }
+
+    /// VPLs one gathering dispatch may take. A software adapter (llvmpipe) ends a shader
+    /// invocation after 65535 loop iterations in all, and each VPL is a BVH traversal of
+    /// up to a few thousand iterations, so there the VPL list is split into ranges of
+    /// this many; a GPU takes the whole list at once.
+    pub fn vpls_per_dispatch(&self) -> u32 {
+        if self.info.device_type == wgpu::DeviceType::Cpu {
+            SOFTWARE_VPLS_PER_DISPATCH
+        } else {
+            u32::MAX
+        }
+    }
+
+    /// "NAME (BACKEND, TYPE, DRIVER)" for reports.
+    pub fn describe(&self) -> String {
+        format!(
+            "{} ({:?}, {:?}, {} {})",
+            self.info.name,
+            self.info.backend,
+            self.info.device_type,
+            self.info.driver,
+            self.info.driver_info
+        )
+    }
+
+    /// Largest storage buffer one binding may hold on this device, in bytes.
+    pub fn max_storage_binding(&self) -> u64 {
+        self.device.limits().max_storage_buffer_binding_size as u64
+    }
+
+    /// Read a storage buffer back to the CPU (through a staging copy).
+    pub fn read_buffer<T: bytemuck::Pod>(&self, buffer: &wgpu::Buffer) -> Result<Vec<T>, GpuError> {
+        let size = buffer.size();
+        let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("readback"),
+            size,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut encoder = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("readback"),
+            });
+        encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, size);
+        self.queue.submit([encoder.finish()]);
+        let slice = staging.slice(..);
+        let (tx, rx) = std::sync::mpsc::channel();
+        slice.map_async(wgpu::MapMode::Read, move |r| {
+            let _ = tx.send(r);
+        });
+        self.finish()?;
+        rx.recv()
+            .map_err(|e| GpuError::Device(e.to_string()))?
+            .map_err(|e| GpuError::Device(e.to_string()))?;
+        let data = slice
+            .get_mapped_range()
+            .map_err(|e| GpuError::Device(e.to_string()))?;
+        let out = bytemuck::cast_slice::<u8, T>(&data).to_vec();
+        drop(data);
+        staging.unmap();
+        Ok(out)
+    }
+}
+
+fn one_line(s: &str) -> String {
+    s.split_whitespace().collect::<Vec<_>>().join(" ")
+}

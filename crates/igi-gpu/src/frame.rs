@@ -1,0 +1,524 @@
+//! The frame (paper section 4): [`Renderer::encode_frame`] lists its passes in order —
+//! VPL shooting, direct + specular, indirect diffuse, compose — each a compute pass with
+//! its own timestamp pair. The renderer owns the scene on the GPU, the passes and the
+//! frame's buffers; nothing is read back inside a frame.
+
+use crate::context::{GpuContext, GpuError};
+use crate::layout::{FrameParams, Vpl};
+use crate::passes::compose::ComposePass;
+use crate::passes::direct::{DirectBindings, DirectPass};
+use crate::passes::{dispatch, gather_range_layout, GatherRanges, GATHER_RANGE_STRIDE};
+use crate::passes::indirect::IndirectPass;
+use crate::passes::vpl::VplPass;
+use crate::profiler::{Profiler, StageTime};
+use crate::scene_buffers::SceneBuffers;
+use igi_core::bvh::Bvh;
+use igi_core::image::Image;
+use igi_core::sampling::{halton_base, pilot_base};
+use igi_core::scene::{Camera, Scene};
+use igi_core::settings::{GeometryBound, OutputBuffer, RenderSettings};
+
+/// The stages of a frame, in order; the index is the stage's timestamp pair.
+pub const STAGES: [&str; 4] = ["vpl shooting", "direct + specular", "indirect", "compose"];
+
+/// Light paths of the pilot run that estimates VPLs per path.
+pub const PILOT_PATHS: u32 = 4096;
+
+/// What one frame produced.
+#[derive(Clone, Debug)]
+pub struct FrameOutput {
+    /// Linear radiance of the chosen output buffer.
+    pub image: Image,
+    /// VPLs actually stored this frame.
+    pub vpl_count: u32,
+    /// Light paths shot to get them.
+    pub path_count: u32,
+    /// GPU time per stage (empty without timestamp queries).
+    pub stages: Vec<StageTime>,
+    /// GPU time from the first stage's start to the last one's end.
+    pub frame_ms: Option<f64>,
+}
+
+/// Buffers sized by the image.
+struct ImageBuffers {
+    width: u32,
+    height: u32,
+    direct: wgpu::Buffer,
+    position: wgpu::Buffer,
+    normal: wgpu::Buffer,
+    geometric: wgpu::Buffer,
+    albedo: wgpu::Buffer,
+    irradiance: wgpu::Buffer,
+    color: wgpu::Buffer,
+}
+
+/// Buffers sized by the number of VPL slots (paths x bounces).
+struct VplBuffers {
+    slots: u64,
+    slot_buffer: wgpu::Buffer,
+    vpls: wgpu::Buffer,
+}
+
+pub struct Renderer {
+    scene: SceneBuffers,
+    vpl: VplPass,
+    direct: DirectPass,
+    indirect: IndirectPass,
+    compose: ComposePass,
+    profiler: Profiler,
+    params: wgpu::Buffer,
+    vpl_header: wgpu::Buffer,
+    /// Bind group 2 of the gathering passes: the VPL ranges of one frame.
+    range_layout: wgpu::BindGroupLayout,
+    range_buffer: Option<(wgpu::Buffer, wgpu::BindGroup, u32)>,
+    vpls_per_dispatch: u32,
+    images: Option<ImageBuffers>,
+    vpl_buffers: Option<VplBuffers>,
+    camera: Camera,
+    light_power_sum: f32,
+    total_power: [f32; 3],
+    diagonal: f32,
+    /// Paths per frame for (seed, vpls, bounces, mirror depth), from the pilot run.
+    path_cache: Option<((u32, u32, u32, u32), u32)>,
+}
+
+fn storage(device: &wgpu::Device, label: &str, size: u64) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: size.max(16),
+        usage: wgpu::BufferUsages::STORAGE
+            | wgpu::BufferUsages::COPY_SRC
+            | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    })
+}
+
+impl Renderer {
+    /// Upload the scene and its BVH, and build the passes.
+    pub fn new(ctx: &GpuContext, scene: &Scene, bvh: &Bvh) -> Result<Renderer, GpuError> {
+        let device = &ctx.device;
+        let scene_buffers = SceneBuffers::upload(ctx, scene, bvh)?;
+        let layout = &scene_buffers.layout;
+        let range_layout = gather_range_layout(device);
+        let renderer = Renderer {
+            vpl: VplPass::new(device, layout),
+            direct: DirectPass::new(device, layout, &range_layout),
+            indirect: IndirectPass::new(device, layout, &range_layout),
+            range_layout,
+            range_buffer: None,
+            vpls_per_dispatch: ctx.vpls_per_dispatch(),
+            compose: ComposePass::new(device, layout),
+            scene: scene_buffers,
+            profiler: Profiler::new(ctx, STAGES.len() as u32),
+            params: device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("frame params"),
+                size: std::mem::size_of::<FrameParams>() as u64,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }),
+            vpl_header: storage(device, "vpl header", 16),
+            images: None,
+            vpl_buffers: None,
+            camera: scene.camera,
+            light_power_sum: scene.lights.iter().map(|l| l.power().element_sum()).sum(),
+            total_power: scene.total_power().to_array(),
+            diagonal: scene.diagonal(),
+            path_cache: None,
+        };
+        ctx.check()?;
+        Ok(renderer)
+    }
+
+    /// Bytes held on the GPU by the scene.
+    pub fn scene_bytes(&self) -> u64 {
+        self.scene.bytes
+    }
+
+    /// Bytes held on the GPU by the frame's buffers (image and VPL buffers).
+    pub fn frame_bytes(&self) -> u64 {
+        let images = self.images.as_ref().map_or(0, |b| {
+            [
+                &b.direct,
+                &b.position,
+                &b.normal,
+                &b.geometric,
+                &b.albedo,
+                &b.irradiance,
+                &b.color,
+            ]
+            .iter()
+            .map(|b| b.size())
+            .sum()
+        });
+        let vpls = self
+            .vpl_buffers
+            .as_ref()
+            .map_or(0, |b| b.slot_buffer.size() + b.vpls.size());
+        images + vpls + self.params.size() + self.vpl_header.size()
+    }
+
+    fn check_size(ctx: &GpuContext, settings: &RenderSettings) -> Result<(), GpuError> {
+        let (w, h) = (settings.width, settings.height);
+        if w == 0 || h == 0 {
+            return Err(GpuError::Limit(format!(
+                "image size {w}x{h}: both must be at least 1"
+            )));
+        }
+        let bytes = w as u64 * h as u64 * 16;
+        if bytes > ctx.max_storage_binding() {
+            return Err(GpuError::Limit(format!(
+                "image size {w}x{h} needs {} MiB per frame buffer, more than this adapter's max_storage_buffer_binding_size of {} MiB",
+                bytes >> 20,
+                ctx.max_storage_binding() >> 20
+            )));
+        }
+        Ok(())
+    }
+
+    fn ensure_images(&mut self, device: &wgpu::Device, width: u32, height: u32) {
+        if let Some(b) = &self.images {
+            if b.width == width && b.height == height {
+                return;
+            }
+        }
+        let size = width as u64 * height as u64 * 16;
+        self.images = Some(ImageBuffers {
+            width,
+            height,
+            direct: storage(device, "direct", size),
+            position: storage(device, "gbuffer position", size),
+            normal: storage(device, "gbuffer normal", size),
+            geometric: storage(device, "gbuffer geometric normal", size),
+            albedo: storage(device, "gbuffer albedo", size),
+            irradiance: storage(device, "irradiance", size),
+            color: storage(device, "color", size),
+        });
+    }
+
+    fn ensure_vpl_slots(&mut self, ctx: &GpuContext, slots: u64) -> Result<(), GpuError> {
+        if self.vpl_buffers.as_ref().is_some_and(|b| b.slots >= slots) {
+            return Ok(());
+        }
+        let bytes = slots * std::mem::size_of::<Vpl>() as u64;
+        if bytes > ctx.max_storage_binding() {
+            return Err(GpuError::Limit(format!(
+                "{slots} VPL slots need {} MiB, more than this adapter's max_storage_buffer_binding_size of {} MiB: ask for fewer VPLs or bounces",
+                bytes >> 20,
+                ctx.max_storage_binding() >> 20
+            )));
+        }
+        self.vpl_buffers = Some(VplBuffers {
+            slots,
+            slot_buffer: storage(&ctx.device, "vpl slots", bytes),
+            vpls: storage(&ctx.device, "vpls", bytes),
+        });
+        Ok(())
+    }
+
+    /// Write the VPL ranges for a frame of `slots` VPL slots (an upper bound of the VPL
+    /// count, which only the GPU knows) and return how many there are.
+    fn ensure_ranges(&mut self, ctx: &GpuContext, slots: u64) -> u32 {
+        let per = self.vpls_per_dispatch as u64;
+        let count = slots.div_ceil(per).max(1) as u32;
+        if self.range_buffer.as_ref().is_none_or(|(_, _, n)| *n != count) {
+            let stride = GATHER_RANGE_STRIDE as usize;
+            let mut bytes = vec![0u8; count as usize * stride];
+            for i in 0..count as usize {
+                let begin = (i as u64 * per).min(u32::MAX as u64) as u32;
+                let end = ((i as u64 + 1) * per).min(u32::MAX as u64) as u32;
+                bytes[i * stride..i * stride + 8].copy_from_slice(bytemuck::cast_slice(&[begin, end]));
+            }
+            let buffer = wgpu::util::DeviceExt::create_buffer_init(
+                &ctx.device,
+                &wgpu::util::BufferInitDescriptor {
+                    label: Some("gather ranges"),
+                    contents: &bytes,
+                    usage: wgpu::BufferUsages::UNIFORM,
+                },
+            );
+            let bind_group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("gather ranges"),
+                layout: &self.range_layout,
+                entries: &[wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                        buffer: &buffer,
+                        offset: 0,
+                        size: wgpu::BufferSize::new(16),
+                    }),
+                }],
+            });
+            self.range_buffer = Some((buffer, bind_group, count));
+        }
+        count
+    }
+
+    fn frame_params(&self, settings: &RenderSettings, paths: u32, base: u32) -> FrameParams {
+        let cam = &self.camera;
+        let forward = (cam.target - cam.eye).normalize();
+        let right = forward.cross(cam.up).normalize();
+        let up = right.cross(forward);
+        let min_dist = settings
+            .min_dist
+            .unwrap_or(igi_core::settings::DEFAULT_MIN_DIST_FRACTION * self.diagonal);
+        FrameParams {
+            cam_eye: cam.eye.to_array(),
+            width: settings.width,
+            cam_forward: forward.to_array(),
+            height: settings.height,
+            cam_right: right.to_array(),
+            tan_half_fov_y: (cam.fov_y_deg.to_radians() * 0.5).tan(),
+            cam_up: up.to_array(),
+            aspect: settings.width as f32 / settings.height as f32,
+            total_power: self.total_power,
+            light_count: self.scene.light_count,
+            path_count: paths,
+            bounces: settings.bounces.max(1),
+            min_dist,
+            geometry_bound: match settings.geometry_bound {
+                GeometryBound::Smoothstep => 0,
+                GeometryBound::Clamp => 1,
+            },
+            mirror_depth: settings.mirror_depth,
+            halton_base: base,
+            output: match settings.output {
+                OutputBuffer::Final => 0,
+                OutputBuffer::Direct => 1,
+                OutputBuffer::Indirect => 2,
+                OutputBuffer::Irradiance => 3,
+            },
+            light_power_sum: self.light_power_sum,
+            _pad: [0; 4],
+        }
+    }
+
+    /// Light paths per frame so that the expected VPL count is `settings.vpls`: a pilot
+    /// run of [`PILOT_PATHS`] paths (a Halton window of its own) measures VPLs per path.
+    /// The count is fixed before, and independently of, the paths it is used with, and
+    /// each path carries 1/M of the power, so the estimator stays unbiased.
+    pub fn path_count(
+        &mut self,
+        ctx: &GpuContext,
+        settings: &RenderSettings,
+    ) -> Result<u32, GpuError> {
+        let key = (
+            settings.seed,
+            settings.vpls,
+            settings.bounces.max(1),
+            settings.mirror_depth,
+        );
+        if let Some((k, paths)) = self.path_cache {
+            if k == key {
+                return Ok(paths);
+            }
+        }
+        let bounces = settings.bounces.max(1);
+        self.ensure_vpl_slots(ctx, PILOT_PATHS as u64 * bounces as u64)?;
+        let params = self.frame_params(settings, PILOT_PATHS, pilot_base(settings.seed));
+        ctx.queue
+            .write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
+        let vb = self.vpl_buffers.as_ref().expect("allocated");
+        let bind = self.vpl.bind(
+            &ctx.device,
+            &self.params,
+            &vb.slot_buffer,
+            &vb.vpls,
+            &self.vpl_header,
+        );
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        dispatch(
+            &mut encoder,
+            &Profiler::disabled(),
+            0,
+            "vpl pilot",
+            &self.vpl.steps(PILOT_PATHS),
+            &self.scene.bind_group,
+            &bind,
+            None,
+        );
+        ctx.queue.submit([encoder.finish()]);
+        let header: Vec<u32> = ctx.read_buffer(&self.vpl_header)?;
+        let per_path = header[0] as f64 / PILOT_PATHS as f64;
+        let paths = if per_path > 0.0 {
+            (settings.vpls as f64 / per_path)
+                .round()
+                .clamp(1.0, u32::MAX as f64 / 64.0) as u32
+        } else {
+            // The lights reach no surface: no VPLs whatever the count.
+            settings.vpls.max(1)
+        };
+        self.path_cache = Some((key, paths));
+        Ok(paths)
+    }
+
+    /// Render one frame and read its image back.
+    pub fn render(
+        &mut self,
+        ctx: &GpuContext,
+        settings: &RenderSettings,
+    ) -> Result<FrameOutput, GpuError> {
+        Self::check_size(ctx, settings)?;
+        let paths = self.path_count(ctx, settings)?;
+        let bounces = settings.bounces.max(1);
+        self.ensure_vpl_slots(ctx, paths as u64 * bounces as u64)?;
+        self.ensure_images(&ctx.device, settings.width, settings.height);
+        self.ensure_ranges(ctx, paths as u64 * bounces as u64);
+        let params = self.frame_params(
+            settings,
+            paths,
+            halton_base(settings.seed, settings.frame, paths),
+        );
+        ctx.queue
+            .write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
+
+        let mut encoder = ctx
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("frame"),
+            });
+        self.encode_frame(
+            &ctx.device,
+            &mut encoder,
+            settings.width,
+            settings.height,
+            paths,
+        );
+        self.profiler.resolve(&mut encoder, STAGES.len() as u32);
+        ctx.queue.submit([encoder.finish()]);
+
+        let images = self.images.as_ref().expect("allocated");
+        let rgba: Vec<[f32; 4]> = ctx.read_buffer(&images.color)?;
+        let pixels = settings.width as usize * settings.height as usize;
+        let header: Vec<u32> = ctx.read_buffer(&self.vpl_header)?;
+        let timing = self.profiler.read(ctx, &STAGES)?;
+        ctx.check()?;
+        let (stages, frame_ms) = match timing {
+            Some((s, span)) => (s, Some(span)),
+            None => (vec![], None),
+        };
+        Ok(FrameOutput {
+            image: Image::from_rgba(settings.width, settings.height, &rgba[..pixels]),
+            vpl_count: header[0],
+            path_count: paths,
+            stages,
+            frame_ms,
+        })
+    }
+
+    /// The VPLs of the last frame (for tests and for drawing them).
+    pub fn read_vpls(&self, ctx: &GpuContext) -> Result<Vec<Vpl>, GpuError> {
+        let header: Vec<u32> = ctx.read_buffer(&self.vpl_header)?;
+        let Some(vb) = &self.vpl_buffers else {
+            return Ok(vec![]);
+        };
+        let mut vpls: Vec<Vpl> = ctx.read_buffer(&vb.vpls)?;
+        vpls.truncate(header[0] as usize);
+        Ok(vpls)
+    }
+
+    /// The passes of one frame, in order (kajiya style: the frame reads top to bottom).
+    pub fn encode_frame(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        width: u32,
+        height: u32,
+        paths: u32,
+    ) {
+        let img = self.images.as_ref().expect("image buffers allocated");
+        let vb = self.vpl_buffers.as_ref().expect("vpl buffers allocated");
+        let scene = &self.scene.bind_group;
+        let p = &self.profiler;
+        let (_, range_group, range_count) = self.range_buffer.as_ref().expect("ranges written");
+        let ranges = GatherRanges {
+            bind_group: range_group,
+            count: *range_count,
+        };
+
+        let vpl_bind = self.vpl.bind(
+            device,
+            &self.params,
+            &vb.slot_buffer,
+            &vb.vpls,
+            &self.vpl_header,
+        );
+        dispatch(
+            encoder,
+            p,
+            0,
+            STAGES[0],
+            &self.vpl.steps(paths),
+            scene,
+            &vpl_bind,
+            None,
+        );
+
+        let direct_bind = self.direct.bind(
+            device,
+            &self.params,
+            DirectBindings {
+                vpls: &vb.vpls,
+                vpl_header: &self.vpl_header,
+                direct: &img.direct,
+                position: &img.position,
+                normal: &img.normal,
+                geometric: &img.geometric,
+                albedo: &img.albedo,
+            },
+        );
+        dispatch(
+            encoder,
+            p,
+            1,
+            STAGES[1],
+            &self.direct.steps(width, height),
+            scene,
+            &direct_bind,
+            Some(&ranges),
+        );
+
+        let indirect_bind = self.indirect.bind(
+            device,
+            &[
+                &self.params,
+                &vb.vpls,
+                &self.vpl_header,
+                &img.position,
+                &img.normal,
+                &img.geometric,
+                &img.irradiance,
+            ],
+        );
+        dispatch(
+            encoder,
+            p,
+            2,
+            STAGES[2],
+            &self.indirect.steps(width, height),
+            scene,
+            &indirect_bind,
+            Some(&ranges),
+        );
+
+        let compose_bind = self.compose.bind(
+            device,
+            &[
+                &self.params,
+                &img.direct,
+                &img.albedo,
+                &img.irradiance,
+                &img.color,
+            ],
+        );
+        dispatch(
+            encoder,
+            p,
+            3,
+            STAGES[3],
+            &self.compose.steps(width, height),
+            scene,
+            &compose_bind,
+            None,
+        );
+    }
+}

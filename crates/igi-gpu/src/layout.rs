@@ -1,0 +1,117 @@
+//! Host/GPU structs, `#[repr(C)]` + Pod, each documented field by field with byte offsets.
+//! The WGSL declarations live in `shaders/scene.wgsl` and `shaders/frame.wgsl`; a test
+//! (tests/layout.rs) checks sizes and offsets against what naga computes for the WGSL.
+
+use bytemuck::{Pod, Zeroable};
+
+pub use igi_core::bvh::BvhNode;
+
+/// Shading data of one triangle in BVH order (48 bytes), read only at hits.
+/// | offset | field | |
+/// |---|---|---|
+/// | 0 | n0: vec3f | unit shading normal at vertex 0 |
+/// | 12 | material: u32 | index into the materials array |
+/// | 16 | n1: vec3f | vertex 1 |
+/// | 28 | _pad1 | |
+/// | 32 | n2: vec3f | vertex 2 |
+/// | 44 | _pad2 | |
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct TriShading {
+    pub n0: [f32; 3],
+    pub material: u32,
+    pub n1: [f32; 3],
+    pub _pad1: u32,
+    pub n2: [f32; 3],
+    pub _pad2: u32,
+}
+
+/// A material (32 bytes): diffuse albedo at 0, mirror reflectance at 16 (rgb + pad each).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuMaterial {
+    pub diffuse: [f32; 3],
+    pub _pad0: f32,
+    pub mirror: [f32; 3],
+    pub _pad1: f32,
+}
+
+/// A point light (32 bytes): position at 0, intensity (W/sr, rgb) at 16.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuLight {
+    pub position: [f32; 3],
+    pub _pad0: f32,
+    pub intensity: [f32; 3],
+    pub _pad1: f32,
+}
+
+/// A virtual point light (64 bytes), as stored by VPL shooting.
+/// | offset | field | |
+/// |---|---|---|
+/// | 0 | position: vec3f | on the surface |
+/// | 12 | valid: u32 | 1 for a stored VPL (slots of paths that ended early stay 0) |
+/// | 16 | normal: vec3f | unit, facing the side the particle came from |
+/// | 28 | bounce: u32 | diffuse hit number along its path, 1 = first hit |
+/// | 32 | flux: vec3f | power carried by the particle on arrival (W) |
+/// | 44 | _pad0 | |
+/// | 48 | albedo: vec3f | diffuse albedo at the VPL |
+/// | 60 | _pad1 | |
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct Vpl {
+    pub position: [f32; 3],
+    pub valid: u32,
+    pub normal: [f32; 3],
+    pub bounce: u32,
+    pub flux: [f32; 3],
+    pub _pad0: f32,
+    pub albedo: [f32; 3],
+    pub _pad1: f32,
+}
+
+/// Parameters of one frame (uniform buffer, 128 bytes).
+/// | offset | field | |
+/// |---|---|---|
+/// | 0 | cam_eye: vec3f | camera position |
+/// | 12 | width: u32 | image width in pixels |
+/// | 16 | cam_forward: vec3f | unit view direction |
+/// | 28 | height: u32 | image height |
+/// | 32 | cam_right: vec3f | unit, image x to the right |
+/// | 44 | tan_half_fov_y: f32 | |
+/// | 48 | cam_up: vec3f | unit, image y upward |
+/// | 60 | aspect: f32 | width / height |
+/// | 64 | total_power: vec3f | sum of 4 pi I over lights (W) |
+/// | 76 | light_count: u32 | |
+/// | 80 | path_count: u32 | light paths shot this frame (M) |
+/// | 84 | bounces: u32 | VPL slots per path (B) |
+/// | 88 | min_dist: f32 | bounding distance m of G |
+/// | 92 | geometry_bound: u32 | 0 smoothstep, 1 clamp |
+/// | 96 | mirror_depth: u32 | Whitted depth limit |
+/// | 100 | halton_base: u32 | first Halton index of this frame's paths |
+/// | 104 | output: u32 | 0 final, 1 direct, 2 indirect, 3 irradiance |
+/// | 108 | light_power_sum: f32 | sum over lights of (r + g + b) of the power: light choice |
+/// | 112 | _pad: 4 x u32 | |
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct FrameParams {
+    pub cam_eye: [f32; 3],
+    pub width: u32,
+    pub cam_forward: [f32; 3],
+    pub height: u32,
+    pub cam_right: [f32; 3],
+    pub tan_half_fov_y: f32,
+    pub cam_up: [f32; 3],
+    pub aspect: f32,
+    pub total_power: [f32; 3],
+    pub light_count: u32,
+    pub path_count: u32,
+    pub bounces: u32,
+    pub min_dist: f32,
+    pub geometry_bound: u32,
+    pub mirror_depth: u32,
+    pub halton_base: u32,
+    pub output: u32,
+    pub light_power_sum: f32,
+    pub _pad: [u32; 4],
+}

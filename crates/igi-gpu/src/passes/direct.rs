@@ -1,0 +1,66 @@
+//! Direct + specular at full resolution (paper section 4, second stage), writing the
+//! G-buffer of the primary hits. See `shaders/direct.wgsl`.
+
+use super::{bind, image_groups, pass_layout, pipeline};
+use crate::scene_buffers::{READ, UNIFORM, WRITE};
+
+pub struct DirectPass {
+    pub layout: wgpu::BindGroupLayout,
+    pipeline: wgpu::ComputePipeline,
+}
+
+/// The buffers the direct pass reads and writes, in binding order after the parameters.
+pub struct DirectBindings<'a> {
+    pub vpls: &'a wgpu::Buffer,
+    pub vpl_header: &'a wgpu::Buffer,
+    pub direct: &'a wgpu::Buffer,
+    pub position: &'a wgpu::Buffer,
+    pub normal: &'a wgpu::Buffer,
+    pub geometric: &'a wgpu::Buffer,
+    pub albedo: &'a wgpu::Buffer,
+}
+
+impl DirectPass {
+    pub fn new(
+        device: &wgpu::Device,
+        scene_layout: &wgpu::BindGroupLayout,
+        range_layout: &wgpu::BindGroupLayout,
+    ) -> DirectPass {
+        let layout = pass_layout(
+            device,
+            "direct",
+            &[UNIFORM, READ, READ, WRITE, WRITE, WRITE, WRITE, WRITE],
+        );
+        DirectPass {
+            pipeline: pipeline(device, "direct", "main", &[scene_layout, &layout, range_layout]),
+            layout,
+        }
+    }
+
+    pub fn bind(
+        &self,
+        device: &wgpu::Device,
+        params: &wgpu::Buffer,
+        b: DirectBindings,
+    ) -> wgpu::BindGroup {
+        bind(
+            device,
+            "direct",
+            &self.layout,
+            &[
+                params,
+                b.vpls,
+                b.vpl_header,
+                b.direct,
+                b.position,
+                b.normal,
+                b.geometric,
+                b.albedo,
+            ],
+        )
+    }
+
+    pub fn steps(&self, width: u32, height: u32) -> [(&wgpu::ComputePipeline, [u32; 3]); 1] {
+        [(&self.pipeline, image_groups(width, height))]
+    }
+}

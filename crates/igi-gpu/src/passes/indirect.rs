@@ -1,0 +1,37 @@
+//! Indirect diffuse light at the primary hits from all VPLs (paper section 4, third
+//! stage), stored as the incident term E without the albedo. See `shaders/indirect.wgsl`.
+
+use super::{bind, image_groups, pass_layout, pipeline};
+use crate::scene_buffers::{READ, UNIFORM, WRITE};
+
+pub struct IndirectPass {
+    pub layout: wgpu::BindGroupLayout,
+    pipeline: wgpu::ComputePipeline,
+}
+
+impl IndirectPass {
+    pub fn new(
+        device: &wgpu::Device,
+        scene_layout: &wgpu::BindGroupLayout,
+        range_layout: &wgpu::BindGroupLayout,
+    ) -> IndirectPass {
+        // params, vpls, vpl_header, position, normal, geometric, irradiance
+        let layout = pass_layout(
+            device,
+            "indirect",
+            &[UNIFORM, READ, READ, READ, READ, READ, WRITE],
+        );
+        IndirectPass {
+            pipeline: pipeline(device, "indirect", "main", &[scene_layout, &layout, range_layout]),
+            layout,
+        }
+    }
+
+    pub fn bind(&self, device: &wgpu::Device, buffers: &[&wgpu::Buffer; 7]) -> wgpu::BindGroup {
+        bind(device, "indirect", &self.layout, buffers)
+    }
+
+    pub fn steps(&self, width: u32, height: u32) -> [(&wgpu::ComputePipeline, [u32; 3]); 1] {
+        [(&self.pipeline, image_groups(width, height))]
+    }
+}

@@ -1,0 +1,180 @@
+//! The passes of the frame (paper section 4), one module per stage with its WGSL in
+//! `shaders/` beside the shared modules. A pass owns its pipeline and the layout of its
+//! bind group 1; bind group 0 is always the scene.
+
+pub mod compose;
+pub mod direct;
+pub mod indirect;
+pub mod vpl;
+
+use crate::profiler::Profiler;
+use crate::scene_buffers::buffer_entry;
+
+/// A pass's own WGSL and whether it gathers from VPLs (then it declares `vpls` and
+/// `vpl_header`, and `gather.wgsl` is composed in).
+pub struct PassSource {
+    pub name: &'static str,
+    pub wgsl: &'static str,
+    pub gathers: bool,
+}
+
+/// Each pass's own WGSL, by name (composed with the shared modules by `shader::compose`).
+pub const SOURCES: &[PassSource] = &[
+    PassSource {
+        name: "vpl",
+        wgsl: include_str!("../shaders/vpl.wgsl"),
+        gathers: false,
+    },
+    PassSource {
+        name: "direct",
+        wgsl: include_str!("../shaders/direct.wgsl"),
+        gathers: true,
+    },
+    PassSource {
+        name: "indirect",
+        wgsl: include_str!("../shaders/indirect.wgsl"),
+        gathers: true,
+    },
+    PassSource {
+        name: "compose",
+        wgsl: include_str!("../shaders/compose.wgsl"),
+        gathers: false,
+    },
+];
+
+/// Workgroup edge of the image passes (8 x 8 threads).
+pub const TILE: u32 = 8;
+
+/// The layout of a pass's bind group 1: binding i has type `types[i]`.
+pub(crate) fn pass_layout(
+    device: &wgpu::Device,
+    label: &str,
+    types: &[wgpu::BufferBindingType],
+) -> wgpu::BindGroupLayout {
+    let entries: Vec<_> = types
+        .iter()
+        .enumerate()
+        .map(|(i, &ty)| buffer_entry(i as u32, ty))
+        .collect();
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some(label),
+        entries: &entries,
+    })
+}
+
+/// A compute pipeline for `entry` of the named pass; `layouts` are its bind groups in
+/// order (the scene first).
+pub(crate) fn pipeline(
+    device: &wgpu::Device,
+    name: &str,
+    entry: &str,
+    layouts: &[&wgpu::BindGroupLayout],
+) -> wgpu::ComputePipeline {
+    let source = SOURCES.iter().find(|s| s.name == name).expect("known pass");
+    let desc = wgpu::ShaderModuleDescriptor {
+        label: Some(name),
+        source: wgpu::ShaderSource::Wgsl(crate::shader::compose(source).into()),
+    };
+    let module = device.create_shader_module(desc);
+    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(name),
+        bind_group_layouts: &layouts.iter().map(|l| Some(*l)).collect::<Vec<_>>(),
+        immediate_size: 0,
+    });
+    device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some(name),
+        layout: Some(&layout),
+        module: &module,
+        entry_point: Some(entry),
+        compilation_options: Default::default(),
+        cache: None,
+    })
+}
+
+/// A bind group whose binding i is the whole of `buffers[i]`.
+pub(crate) fn bind(
+    device: &wgpu::Device,
+    label: &str,
+    layout: &wgpu::BindGroupLayout,
+    buffers: &[&wgpu::Buffer],
+) -> wgpu::BindGroup {
+    let entries: Vec<_> = buffers
+        .iter()
+        .enumerate()
+        .map(|(i, b)| wgpu::BindGroupEntry {
+            binding: i as u32,
+            resource: b.as_entire_binding(),
+        })
+        .collect();
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some(label),
+        layout,
+        entries: &entries,
+    })
+}
+
+/// Byte stride of the VPL ranges in the gather-range buffer (the dynamic-offset alignment).
+pub const GATHER_RANGE_STRIDE: u64 = 256;
+
+/// The layout of bind group 2 of gathering passes: one VPL range, by dynamic offset.
+pub fn gather_range_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("gather range"),
+        entries: &[wgpu::BindGroupLayoutEntry {
+            binding: 0,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Uniform,
+                has_dynamic_offset: true,
+                min_binding_size: wgpu::BufferSize::new(16),
+            },
+            count: None,
+        }],
+    })
+}
+
+/// The gather ranges of a frame: bind group 2 of the gathering passes, and how many
+/// ranges (dispatches) each of them takes.
+pub struct GatherRanges<'a> {
+    pub bind_group: &'a wgpu::BindGroup,
+    pub count: u32,
+}
+
+/// One compute pass with its own timestamp pair, running each step's pipeline over its
+/// workgroups; with `ranges`, every step runs once per VPL range (bind group 2).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn dispatch(
+    encoder: &mut wgpu::CommandEncoder,
+    profiler: &Profiler,
+    stage: u32,
+    label: &str,
+    steps: &[(&wgpu::ComputePipeline, [u32; 3])],
+    scene: &wgpu::BindGroup,
+    pass: &wgpu::BindGroup,
+    ranges: Option<&GatherRanges>,
+) {
+    let mut cpass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+        label: Some(label),
+        timestamp_writes: profiler.pass_writes(stage),
+    });
+    cpass.set_bind_group(0, scene, &[]);
+    cpass.set_bind_group(1, pass, &[]);
+    for (pipeline, groups) in steps {
+        cpass.set_pipeline(pipeline);
+        match ranges {
+            None => cpass.dispatch_workgroups(groups[0], groups[1], groups[2]),
+            Some(r) => {
+                for i in 0..r.count {
+                    let offset = (i as u64 * GATHER_RANGE_STRIDE) as u32;
+                    cpass.set_bind_group(2, r.bind_group, &[offset]);
+                    cpass.dispatch_workgroups(groups[0], groups[1], groups[2]);
+                }
+            }
+        }
+    }
+}
+
+/// Workgroups covering a width x height image with TILE x TILE groups.
+pub fn image_groups(width: u32, height: u32) -> [u32; 3] {
+    [width.div_ceil(TILE), height.div_ceil(TILE), 1]
+}

@@ -1,0 +1,111 @@
+//! GPU time per stage from timestamp queries (paper section 5 reports the share of each
+//! stage): every stage is its own compute pass with a begin/end timestamp pair.
+
+use crate::context::{GpuContext, GpuError};
+
+/// GPU time of one stage of a frame.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StageTime {
+    pub name: &'static str,
+    pub ms: f64,
+}
+
+pub struct Profiler {
+    query_set: Option<wgpu::QuerySet>,
+    resolve: Option<wgpu::Buffer>,
+    capacity: u32,
+}
+
+impl Profiler {
+    /// Room for `stages` begin/end pairs; inert when the device has no timestamps.
+    pub fn new(ctx: &GpuContext, stages: u32) -> Profiler {
+        if !ctx.timestamps {
+            return Profiler {
+                query_set: None,
+                resolve: None,
+                capacity: stages,
+            };
+        }
+        let count = 2 * stages;
+        let query_set = ctx.device.create_query_set(&wgpu::QuerySetDescriptor {
+            label: Some("stage timestamps"),
+            ty: wgpu::QueryType::Timestamp,
+            count,
+        });
+        let resolve = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("timestamp resolve"),
+            size: 8 * count as u64,
+            usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        Profiler {
+            query_set: Some(query_set),
+            resolve: Some(resolve),
+            capacity: stages,
+        }
+    }
+
+    pub fn enabled(&self) -> bool {
+        self.query_set.is_some()
+    }
+
+    /// The timestamp writes for the compute pass of stage `stage`.
+    pub fn pass_writes(&self, stage: u32) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
+        assert!(
+            stage < self.capacity,
+            "profiler has room for {} stages",
+            self.capacity
+        );
+        self.query_set
+            .as_ref()
+            .map(|qs| wgpu::ComputePassTimestampWrites {
+                query_set: qs,
+                beginning_of_pass_write_index: Some(2 * stage),
+                end_of_pass_write_index: Some(2 * stage + 1),
+            })
+    }
+
+    /// Copy the timestamps of the first `stages` stages into the resolve buffer.
+    pub fn resolve(&self, encoder: &mut wgpu::CommandEncoder, stages: u32) {
+        if let (Some(qs), Some(buf)) = (&self.query_set, &self.resolve) {
+            encoder.resolve_query_set(qs, 0..2 * stages, buf, 0);
+        }
+    }
+
+    /// Read the stage times back (after the frame's submission), with the span from the
+    /// first stage's start to the last one's end; `None` without timestamps.
+    pub fn read(
+        &self,
+        ctx: &GpuContext,
+        names: &[&'static str],
+    ) -> Result<Option<(Vec<StageTime>, f64)>, GpuError> {
+        let Some(buf) = &self.resolve else {
+            return Ok(None);
+        };
+        let ticks: Vec<u64> = ctx.read_buffer(buf)?;
+        let ms = |from: u64, to: u64| {
+            to.saturating_sub(from) as f64 * ctx.queue.get_timestamp_period() as f64 * 1e-6
+        };
+        let stages = names
+            .iter()
+            .enumerate()
+            .map(|(i, &name)| StageTime {
+                name,
+                ms: ms(ticks[2 * i], ticks[2 * i + 1]),
+            })
+            .collect();
+        let span = ms(ticks[0], ticks[2 * names.len() - 1]);
+        Ok(Some((stages, span)))
+    }
+}
+
+impl Profiler {
+    /// A profiler that records nothing (for work outside the timed frame).
+    pub fn disabled() -> Profiler {
+        Profiler {
+            query_set: None,
+            resolve: None,
+            capacity: u32::MAX,
+        }
+    }
+}

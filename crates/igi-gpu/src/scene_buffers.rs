@@ -1,0 +1,139 @@
+//! The scene on the GPU: BVH nodes, triangle vertices and shading data in BVH order,
+//! materials and lights, as bind group 0 of every pass (`shaders/scene.wgsl`).
+
+use crate::context::{GpuContext, GpuError};
+use crate::layout::{GpuLight, GpuMaterial, TriShading};
+use igi_core::bvh::Bvh;
+use igi_core::scene::Scene;
+use wgpu::util::DeviceExt;
+
+pub struct SceneBuffers {
+    pub layout: wgpu::BindGroupLayout,
+    pub bind_group: wgpu::BindGroup,
+    pub light_count: u32,
+    /// Bytes held on the GPU by the scene.
+    pub bytes: u64,
+}
+
+/// A bind group layout entry for a compute-stage storage or uniform buffer.
+pub fn buffer_entry(binding: u32, ty: wgpu::BufferBindingType) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Buffer {
+            ty,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+pub const READ: wgpu::BufferBindingType = wgpu::BufferBindingType::Storage { read_only: true };
+pub const WRITE: wgpu::BufferBindingType = wgpu::BufferBindingType::Storage { read_only: false };
+pub const UNIFORM: wgpu::BufferBindingType = wgpu::BufferBindingType::Uniform;
+
+/// A storage buffer with `data` (at least 16 bytes: empty arrays still need a binding),
+/// after checking it fits one binding on this device.
+pub fn storage_buffer(
+    ctx: &GpuContext,
+    label: &str,
+    data: &[u8],
+) -> Result<wgpu::Buffer, GpuError> {
+    let limit = ctx.max_storage_binding();
+    if data.len() as u64 > limit {
+        return Err(GpuError::Limit(format!(
+            "the scene's {label} buffer needs {} MiB, more than this adapter's max_storage_buffer_binding_size of {} MiB",
+            data.len() >> 20,
+            limit >> 20
+        )));
+    }
+    let mut bytes = data.to_vec();
+    bytes.resize(bytes.len().max(16), 0);
+    Ok(ctx
+        .device
+        .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some(label),
+            contents: &bytes,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+        }))
+}
+
+impl SceneBuffers {
+    pub fn layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+        device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("scene"),
+            entries: &(0..5).map(|b| buffer_entry(b, READ)).collect::<Vec<_>>(),
+        })
+    }
+
+    pub fn upload(ctx: &GpuContext, scene: &Scene, bvh: &Bvh) -> Result<SceneBuffers, GpuError> {
+        let shading: Vec<TriShading> = bvh
+            .tri_order
+            .iter()
+            .map(|&i| {
+                let t = &scene.triangles[i as usize];
+                TriShading {
+                    n0: t.n[0].to_array(),
+                    material: t.material,
+                    n1: t.n[1].to_array(),
+                    _pad1: 0,
+                    n2: t.n[2].to_array(),
+                    _pad2: 0,
+                }
+            })
+            .collect();
+        let materials: Vec<GpuMaterial> = scene
+            .materials
+            .iter()
+            .map(|m| GpuMaterial {
+                diffuse: m.diffuse.to_array(),
+                _pad0: 0.0,
+                mirror: m.mirror.to_array(),
+                _pad1: 0.0,
+            })
+            .collect();
+        let lights: Vec<GpuLight> = scene
+            .lights
+            .iter()
+            .map(|l| GpuLight {
+                position: l.position.to_array(),
+                _pad0: 0.0,
+                intensity: l.intensity.to_array(),
+                _pad1: 0.0,
+            })
+            .collect();
+        let buffers = [
+            storage_buffer(ctx, "BVH nodes", bytemuck::cast_slice(&bvh.nodes))?,
+            storage_buffer(
+                ctx,
+                "triangle vertices",
+                bytemuck::cast_slice(&bvh.tri_verts),
+            )?,
+            storage_buffer(ctx, "triangle shading", bytemuck::cast_slice(&shading))?,
+            storage_buffer(ctx, "materials", bytemuck::cast_slice(&materials))?,
+            storage_buffer(ctx, "lights", bytemuck::cast_slice(&lights))?,
+        ];
+        let bytes = buffers.iter().map(|b| b.size()).sum();
+        let layout = Self::layout(&ctx.device);
+        let entries: Vec<wgpu::BindGroupEntry> = buffers
+            .iter()
+            .enumerate()
+            .map(|(i, b)| wgpu::BindGroupEntry {
+                binding: i as u32,
+                resource: b.as_entire_binding(),
+            })
+            .collect();
+        let bind_group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("scene"),
+            layout: &layout,
+            entries: &entries,
+        });
+        Ok(SceneBuffers {
+            layout,
+            bind_group,
+            light_count: lights.len() as u32,
+            bytes,
+        })
+    }
+}

@@ -1,0 +1,27 @@
+// compose.wgsl: the final image (paper section 4, last stage):
+// L = direct_specular + (rho_d(x) / pi) E(x), linear radiance; tone mapping happens only
+// when an image is written. `params.output` picks another buffer for inspection.
+
+@group(1) @binding(1) var<storage, read> direct_in: array<vec4<f32>>;
+@group(1) @binding(2) var<storage, read> gbuf_albedo: array<vec4<f32>>;
+@group(1) @binding(3) var<storage, read> irradiance_in: array<vec4<f32>>;
+@group(1) @binding(4) var<storage, read_write> color_out: array<vec4<f32>>;
+
+@compute @workgroup_size(8, 8)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    if (gid.x >= params.width || gid.y >= params.height) {
+        return;
+    }
+    let pixel = gid.y * params.width + gid.x;
+    let direct = direct_in[pixel].xyz;
+    let e = irradiance_in[pixel].xyz;
+    let indirect = gbuf_albedo[pixel].xyz / PI * e;
+    var c = direct + indirect;
+    switch params.output {
+        case 1u: { c = direct; }
+        case 2u: { c = indirect; }
+        case 3u: { c = e; }
+        default: {}
+    }
+    color_out[pixel] = vec4<f32>(c, 1.0);
+}

@@ -1,0 +1,78 @@
+// direct.wgsl: direct + specular at full resolution (paper section 4, second stage). One
+// primary ray per pixel; at each hit the point lights add (rho_d / pi) I V cos / d^2, a
+// mirror part continues the Whitted tree up to the depth limit, and at hits reached
+// through mirrors the indirect diffuse term is gathered here from the full VPL set (no
+// screen-space pass reaches them). Writes the G-buffer of the primary hit.
+// When the VPL list is gathered in several ranges (see gather.wgsl), the first dispatch
+// does everything and later ones walk the mirror chain again, adding only their range's
+// indirect light at mirrored hits.
+
+@group(1) @binding(1) var<storage, read> vpls: array<Vpl>;
+@group(1) @binding(2) var<storage, read> vpl_header: VplHeader;
+@group(1) @binding(3) var<storage, read_write> direct_out: array<vec4<f32>>;
+// G-buffer: position (w = 1 where a surface was hit), shading normal, geometric normal,
+// diffuse albedo.
+@group(1) @binding(4) var<storage, read_write> gbuf_position: array<vec4<f32>>;
+@group(1) @binding(5) var<storage, read_write> gbuf_normal: array<vec4<f32>>;
+@group(1) @binding(6) var<storage, read_write> gbuf_geometric: array<vec4<f32>>;
+@group(1) @binding(7) var<storage, read_write> gbuf_albedo: array<vec4<f32>>;
+
+@compute @workgroup_size(8, 8)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    if (gid.x >= params.width || gid.y >= params.height) {
+        return;
+    }
+    let pixel = gid.y * params.width + gid.x;
+    var origin = params.cam_eye;
+    var dir = camera_ray_dir(gid.x, gid.y);
+    var throughput = vec3<f32>(1.0);
+    var radiance = vec3<f32>(0.0);
+    let first_range = gather_first() == 0u;
+    if (first_range) {
+        gbuf_position[pixel] = vec4<f32>(0.0);
+        gbuf_normal[pixel] = vec4<f32>(0.0);
+        gbuf_geometric[pixel] = vec4<f32>(0.0);
+        gbuf_albedo[pixel] = vec4<f32>(0.0);
+    } else {
+        // Later ranges only add light at mirrored hits: nothing to do without a mirror.
+        if (gbuf_albedo[pixel].w == 0.0) {
+            return;
+        }
+        radiance = direct_out[pixel].xyz;
+    }
+    for (var depth = 0u; depth <= params.mirror_depth; depth += 1u) {
+        let hit = trace_closest(origin, dir, INFINITY);
+        if (hit.tri == NO_HIT) {
+            break;
+        }
+        let s = surface_at(origin, dir, hit);
+        if (depth == 0u && first_range) {
+            gbuf_position[pixel] = vec4<f32>(s.position, 1.0);
+            gbuf_normal[pixel] = vec4<f32>(s.shading_normal, hit.t);
+            gbuf_geometric[pixel] = vec4<f32>(s.geometric_normal, 0.0);
+            // w: 1 where the pixel's mirror chain goes on (see the later ranges above).
+            let mirrored = max(s.mirror.x, max(s.mirror.y, s.mirror.z)) > 0.0;
+            gbuf_albedo[pixel] = vec4<f32>(s.diffuse, select(0.0, 1.0, mirrored));
+        }
+        if (max(s.diffuse.x, max(s.diffuse.y, s.diffuse.z)) > 0.0) {
+            var e = vec3<f32>(0.0);
+            if (first_range) {
+                e = direct_irradiance(s.position, s.geometric_normal, s.shading_normal);
+            }
+            if (depth > 0u) {
+                e += vpl_irradiance(s.position, s.geometric_normal, s.shading_normal, gather_first(), gather_last(), 1u);
+            }
+            radiance += throughput * s.diffuse / PI * e;
+        }
+        if (max(s.mirror.x, max(s.mirror.y, s.mirror.z)) <= 0.0) {
+            break;
+        }
+        throughput *= s.mirror;
+        dir = reflect(dir, s.shading_normal);
+        if (dot(dir, s.geometric_normal) <= 0.0) {
+            dir = reflect(dir, s.geometric_normal);
+        }
+        origin = offset_ray_origin(s.position, s.geometric_normal);
+    }
+    direct_out[pixel] = vec4<f32>(radiance, 1.0);
+}

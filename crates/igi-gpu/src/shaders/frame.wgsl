@@ -1,0 +1,161 @@
+// frame.wgsl: what every pass of the frame shares: the frame parameters (binding 0 of
+// group 1 in every pass), the VPL record, the Halton sequence (GPU twin of
+// igi_core::sampling), sampling maps, hit shading and the bounded geometry term.
+
+const PI: f32 = 3.14159265358979;
+const INFINITY: f32 = 3.4e38;
+const ONE_MINUS_EPSILON: f32 = 0.99999994;
+
+struct FrameParams {
+    cam_eye: vec3<f32>, width: u32,
+    cam_forward: vec3<f32>, height: u32,
+    cam_right: vec3<f32>, tan_half_fov_y: f32,
+    cam_up: vec3<f32>, aspect: f32,
+    total_power: vec3<f32>, light_count: u32,
+    path_count: u32, bounces: u32, min_dist: f32, geometry_bound: u32,
+    mirror_depth: u32, halton_base: u32, output: u32, light_power_sum: f32,
+    _pad0: u32, _pad1: u32, _pad2: u32, _pad3: u32,
+}
+
+// A virtual point light: 64 bytes, see layout.rs.
+struct Vpl {
+    position: vec3<f32>, valid: u32,
+    normal: vec3<f32>, bounce: u32,
+    flux: vec3<f32>, _pad0: f32,
+    albedo: vec3<f32>, _pad1: f32,
+}
+
+// Number of VPLs after compaction, and what they came from.
+struct VplHeader {
+    count: u32,
+    path_count: u32,
+    slots: u32,
+    _pad: u32,
+}
+
+@group(1) @binding(0) var<uniform> params: FrameParams;
+
+const PRIMES = array<u32, 64>(2u, 3u, 5u, 7u, 11u, 13u, 17u, 19u, 23u, 29u, 31u, 37u, 41u, 43u, 47u, 53u, 59u, 61u, 67u, 71u, 73u, 79u, 83u, 89u, 97u, 101u, 103u, 107u, 109u, 113u, 127u, 131u, 137u, 139u, 149u, 151u, 157u, 163u, 167u, 173u, 179u, 181u, 191u, 193u, 197u, 199u, 211u, 223u, 227u, 229u, 233u, 239u, 241u, 251u, 257u, 263u, 269u, 271u, 277u, 281u, 283u, 293u, 307u, 311u);
+
+// Radical inverse accumulated in f32 digit by digit, as igi_core::sampling does it.
+fn radical_inverse(base: u32, index: u32) -> f32 {
+    let inv_base = 1.0 / f32(base);
+    var n = index;
+    var weight = inv_base;
+    var value = 0.0;
+    while (n > 0u) {
+        let next = n / base;
+        let digit = n - next * base;
+        value += f32(digit) * weight;
+        weight *= inv_base;
+        n = next;
+    }
+    return min(value, ONE_MINUS_EPSILON);
+}
+
+fn halton(dim: u32, index: u32) -> f32 {
+    return radical_inverse(PRIMES[dim % 64u], index);
+}
+
+fn uniform_sphere(u1: f32, u2: f32) -> vec3<f32> {
+    let z = 1.0 - 2.0 * u1;
+    let r = sqrt(max(1.0 - z * z, 0.0));
+    let phi = 2.0 * PI * u2;
+    return vec3<f32>(r * cos(phi), r * sin(phi), z);
+}
+
+fn cosine_hemisphere(u1: f32, u2: f32) -> vec3<f32> {
+    let r = sqrt(u1);
+    let phi = 2.0 * PI * u2;
+    return vec3<f32>(r * cos(phi), r * sin(phi), sqrt(max(1.0 - u1, 0.0)));
+}
+
+// Duff et al. 2017: an orthonormal basis around unit n, as two columns t, b.
+fn basis_t(n: vec3<f32>) -> vec3<f32> {
+    let s = select(-1.0, 1.0, n.z >= 0.0);
+    let a = -1.0 / (s + n.z);
+    return vec3<f32>(1.0 + s * n.x * n.x * a, s * n.x * n.y * a, -s * n.x);
+}
+fn basis_b(n: vec3<f32>) -> vec3<f32> {
+    let s = select(-1.0, 1.0, n.z >= 0.0);
+    let a = -1.0 / (s + n.z);
+    return vec3<f32>(n.x * n.y * a, s + n.y * n.y * a, -n.y);
+}
+
+fn mean3(v: vec3<f32>) -> f32 {
+    return (v.x + v.y + v.z) / 3.0;
+}
+
+// What a closest hit looks like to shading. Surfaces are two-sided: both normals face the
+// side the ray came from.
+struct SurfaceHit {
+    position: vec3<f32>,
+    geometric_normal: vec3<f32>,
+    shading_normal: vec3<f32>,
+    diffuse: vec3<f32>,
+    mirror: vec3<f32>,
+}
+
+fn surface_at(origin: vec3<f32>, dir: vec3<f32>, hit: Hit) -> SurfaceHit {
+    var s: SurfaceHit;
+    let v0 = tri_verts[3u * hit.tri].xyz;
+    let v1 = tri_verts[3u * hit.tri + 1u].xyz;
+    let v2 = tri_verts[3u * hit.tri + 2u].xyz;
+    // Barycentric position: on the triangle, not origin + t dir, whose rounding can put
+    // the point behind the surface.
+    s.position = (1.0 - hit.u - hit.v) * v0 + hit.u * v1 + hit.v * v2;
+    var ng = normalize(cross(v1 - v0, v2 - v0));
+    if (dot(ng, dir) > 0.0) {
+        ng = -ng;
+    }
+    let sh = tri_shading[hit.tri];
+    var ns = (1.0 - hit.u - hit.v) * sh.n0 + hit.u * sh.n1 + hit.v * sh.n2;
+    let len = length(ns);
+    ns = select(ng, ns / len, len > 1e-12);
+    if (dot(ns, ng) < 0.0) {
+        ns = -ns;
+    }
+    s.geometric_normal = ng;
+    s.shading_normal = ns;
+    let m = materials[sh.material];
+    s.diffuse = m.diffuse;
+    s.mirror = m.mirror;
+    return s;
+}
+
+// The primary ray through the centre of pixel (x, y); y = 0 is the top row.
+fn camera_ray_dir(x: u32, y: u32) -> vec3<f32> {
+    let sx = (2.0 * (f32(x) + 0.5) / f32(params.width) - 1.0) * params.tan_half_fov_y * params.aspect;
+    let sy = (1.0 - 2.0 * (f32(y) + 0.5) / f32(params.height)) * params.tan_half_fov_y;
+    return normalize(params.cam_forward + sx * params.cam_right + sy * params.cam_up);
+}
+
+// The bound on the distance part of G: the paper's smoothstep(0.8 m, 1.2 m, d) / d^2, or
+// the classic clamp 1 / max(d^2, m^2).
+fn bounded_inverse_square(dist2: f32) -> f32 {
+    let m = params.min_dist;
+    if (params.geometry_bound == 1u) {
+        return 1.0 / max(dist2, m * m);
+    }
+    return smoothstep(0.8 * m, 1.2 * m, sqrt(dist2)) / dist2;
+}
+
+// Irradiance from the point lights at p (shadow rays from the surface to each light).
+fn direct_irradiance(p: vec3<f32>, ng: vec3<f32>, ns: vec3<f32>) -> vec3<f32> {
+    var e = vec3<f32>(0.0);
+    let origin = offset_ray_origin(p, ng);
+    for (var l = 0u; l < params.light_count; l += 1u) {
+        let light = lights[l];
+        let d = light.position - p;
+        let dist2 = dot(d, d);
+        let cos_x = dot(ns, d) * inverseSqrt(dist2);
+        if (cos_x <= 0.0 || dot(ng, d) <= 0.0) {
+            continue;
+        }
+        if (trace_any(origin, light.position - origin, 1.0)) {
+            continue;
+        }
+        e += light.intensity * cos_x / dist2;
+    }
+    return e;
+}

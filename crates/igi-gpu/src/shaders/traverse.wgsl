@@ -1,0 +1,302 @@
+// traverse.wgsl: the ray-tracing layer of igi, which replaces OptiX in the system of
+// Marques and Santos ("Instant Global Illumination on the GPU using OptiX"): closest-hit
+// and any-hit traversal of the BVH of scene.wgsl (bvh_nodes, tri_verts), the watertight
+// ray-triangle test (Woop, Benthin, Wald, JCGT 2013), the robust slab test (Ize, JCGT
+// 2013) and the ray origin offset of Wächter and Binder (Ray Tracing Gems, ch. 6).
+//
+// Composed after scene.wgsl. CPU twin: crates/igi-core/src/bvh/traverse.rs, the same
+// algorithm in the same order; the reasons behind each choice are written there. Change
+// both together: crates/igi-gpu/tests/traverse_gpu.rs compares them ray by ray.
+//
+// Results can differ from the CPU only by rounding: WGSL allows division to be 2.5 ulp,
+// and GPU compilers may fuse a * b + c into one fma. Neither can break watertightness:
+// the inside test compares rounded products and never looks at a fused difference.
+
+// Hit.tri of a miss.
+const NO_HIT: u32 = 0xffffffffu;
+
+// Entries of the traversal stack; equals igi_core::bvh::MAX_DEPTH (a test checks it).
+// Only far interior children are pushed, at most one per interior ancestor of the node
+// being visited; the builder makes no interior node at depth >= MAX_DEPTH (root: depth
+// 0), so a push happens at depth d <= MAX_DEPTH - 1 onto at most d entries: the stack
+// never holds more than MAX_DEPTH entries and cannot overflow.
+const STACK_SIZE: u32 = 60u;
+
+// Direction components below this count as zero for the slab test (parallel axes).
+const DIR_EPS: f32 = 1e-30;
+// Reciprocal of a parallel axis: finite, since WGSL makes inf and NaN indeterminate.
+const PARALLEL_INV: f32 = 1e30;
+// Exit distance of a parallel axis whose slab contains the origin: "never exits".
+const FAR_BIG: f32 = 1e38;
+// 1 + 2 gamma(3), rounded to f32 (1 + 3 ulp): conservative far end of a slab.
+const BOX_TFAR_SCALE: f32 = 1.0000003576278687;
+
+// Wächter-Binder offset constants: near-origin threshold, absolute offset, ulp count.
+const OFFSET_ORIGIN: f32 = 0.03125;
+const OFFSET_FLOAT_SCALE: f32 = 0.0000152587890625;
+const OFFSET_INT_SCALE: f32 = 256.0;
+
+// A hit: origin + t dir lies on triangle `tri` (BVH slot; tri_order maps it to the scene's
+// index), with barycentric weights u of vertex 1 and v of vertex 2. 16 bytes, like
+// igi_core::bvh::Hit: t 0..4, tri 4..8, u 8..12, v 12..16.
+struct Hit {
+    t: f32,
+    tri: u32,
+    u: f32,
+    v: f32,
+}
+
+// Per-ray constants, computed once by make_ray.
+struct TraceRay {
+    origin: vec3<f32>,
+    inv_dir: vec3<f32>,
+    // Woop et al. shear (dir[kx] / dir[kz], dir[ky] / dir[kz], 1 / dir[kz]).
+    shear: vec3<f32>,
+    kx: u32,
+    ky: u32,
+    kz: u32,
+    // inv_dir < 0: the slab of that axis is entered at the box maximum.
+    neg: vec3<bool>,
+    // |dir| < DIR_EPS: the ray is parallel to that axis' slab.
+    parallel: vec3<bool>,
+}
+
+// The shadow ray of a segment between two surface points (see shadow_segment).
+struct ShadowSegment {
+    origin: vec3<f32>,
+    dir: vec3<f32>,
+}
+
+fn make_ray(origin: vec3<f32>, dir: vec3<f32>) -> TraceRay {
+    let parallel = abs(dir) < vec3<f32>(DIR_EPS);
+    // Divide by 1 in parallel lanes so that no lane ever computes 1 / 0.
+    let inv_dir = select(vec3<f32>(1.0) / select(dir, vec3<f32>(1.0), parallel), vec3<f32>(PARALLEL_INV), parallel);
+    let a = abs(dir);
+    // Ties go to the lower axis (as on the CPU).
+    var kz = 0u;
+    if (a.y > a.x) {
+        kz = 1u;
+    }
+    if (a.z > a[kz]) {
+        kz = 2u;
+    }
+    var kx = (kz + 1u) % 3u;
+    var ky = (kx + 1u) % 3u;
+    if (dir[kz] < 0.0) {
+        let k = kx;
+        kx = ky;
+        ky = k;
+    }
+    let shear = vec3<f32>(dir[kx] / dir[kz], dir[ky] / dir[kz], 1.0 / dir[kz]);
+    return TraceRay(origin, inv_dir, shear, kx, ky, kz, inv_dir < vec3<f32>(0.0), parallel);
+}
+
+// Slab test: the entry distance (>= 0) of a box hit within [0, tmax], or -1. Entry planes
+// are chosen by the direction's sign, so an inverted empty box (+inf, -inf) is never hit.
+fn box_near(bmin: vec3<f32>, bmax: vec3<f32>, r: TraceRay, tmax: f32) -> f32 {
+    let t0 = (bmin - r.origin) * r.inv_dir;
+    let t1 = (bmax - r.origin) * r.inv_dir;
+    let tn = select(t0, t1, r.neg);
+    var tf = select(t1, t0, r.neg);
+    // A parallel axis whose slab holds the origin (even on a plane) never exits.
+    tf = select(tf, vec3<f32>(FAR_BIG), r.parallel & (tf >= vec3<f32>(0.0)));
+    let near = max(max(tn.x, tn.y), max(tn.z, 0.0));
+    let far = min(min(min(tf.x, tf.y), tf.z) * BOX_TFAR_SCALE, tmax);
+    return select(-1.0, near, near <= far);
+}
+
+// Watertight two-sided ray-triangle test: (t, u, v) of a hit with 0 < t < tmax, else
+// t = -1. Edge and vertex hits count: a ray through a shared edge or vertex never leaks.
+fn intersect_triangle(r: TraceRay, v0: vec3<f32>, v1: vec3<f32>, v2: vec3<f32>, tmax: f32) -> vec3<f32> {
+    let miss = vec3<f32>(-1.0, 0.0, 0.0);
+    let a = v0 - r.origin;
+    let b = v1 - r.origin;
+    let c = v2 - r.origin;
+    let ax = a[r.kx] - r.shear.x * a[r.kz];
+    let ay = a[r.ky] - r.shear.y * a[r.kz];
+    let bx = b[r.kx] - r.shear.x * b[r.kz];
+    let by = b[r.ky] - r.shear.y * b[r.kz];
+    let cx = c[r.kx] - r.shear.x * c[r.kz];
+    let cy = c[r.ky] - r.shear.y * c[r.kz];
+    // Edge functions U (weight of v0), V (v1), W (v2) as pairs of rounded products: the
+    // signs come from comparing them, never from a (possibly fused) difference.
+    let pu1 = cx * by;
+    let pu2 = cy * bx;
+    let pv1 = ax * cy;
+    let pv2 = ay * cx;
+    let pw1 = bx * ay;
+    let pw2 = by * ax;
+    let inside = (pu1 >= pu2 && pv1 >= pv2 && pw1 >= pw2) || (pu1 <= pu2 && pv1 <= pv2 && pw1 <= pw2);
+    if (!inside) {
+        return miss;
+    }
+    let eu = pu1 - pu2;
+    let ev = pv1 - pv2;
+    let ew = pw1 - pw2;
+    let det = eu + ev + ew;
+    if (det == 0.0) {
+        return miss;
+    }
+    let az = r.shear.z * a[r.kz];
+    let bz = r.shear.z * b[r.kz];
+    let cz = r.shear.z * c[r.kz];
+    let tt = eu * az + ev * bz + ew * cz;
+    let rcp = 1.0 / det;
+    let t = tt * rcp;
+    if (t > 0.0 && t < tmax) {
+        return vec3<f32>(t, ev * rcp, ew * rcp);
+    }
+    return miss;
+}
+
+// The triangles of a leaf in slot order; equal distances keep the first hit.
+fn leaf_closest(first: u32, count: u32, r: TraceRay, hit_in: Hit) -> Hit {
+    var hit = hit_in;
+    for (var slot = first; slot < first + count; slot++) {
+        let i = 3u * slot;
+        let h = intersect_triangle(r, tri_verts[i].xyz, tri_verts[i + 1u].xyz, tri_verts[i + 2u].xyz, hit.t);
+        if (h.x > 0.0) {
+            hit = Hit(h.x, slot, h.y, h.z);
+        }
+    }
+    return hit;
+}
+
+fn leaf_any(first: u32, count: u32, r: TraceRay, tmax: f32) -> bool {
+    for (var slot = first; slot < first + count; slot++) {
+        let i = 3u * slot;
+        let h = intersect_triangle(r, tri_verts[i].xyz, tri_verts[i + 1u].xyz, tri_verts[i + 2u].xyz, tmax);
+        if (h.x > 0.0) {
+            return true;
+        }
+    }
+    return false;
+}
+
+// Closest hit with 0 < t < tmax; Hit.tri == NO_HIT (and t = tmax) on a miss. `dir` need
+// not be normalised: t is in units of dir. Nearer child first; leaf children are tested
+// as soon as their box is hit, interior ones descended into (the nearer) or pushed.
+fn trace_closest(origin: vec3<f32>, dir: vec3<f32>, tmax: f32) -> Hit {
+    var hit = Hit(tmax, NO_HIT, 0.0, 0.0);
+    if (all(dir == vec3<f32>(0.0))) {
+        return hit;
+    }
+    let r = make_ray(origin, dir);
+    var stack: array<u32, STACK_SIZE>;
+    var sp = 0u;
+    var node = 0u;
+    loop {
+        let n = bvh_nodes[node];
+        let ta = box_near(n.a_min, n.a_max, r, hit.t);
+        let tb = box_near(n.b_min, n.b_max, r, hit.t);
+        // Nearer child first; ties and misses of b: a first.
+        let b_first = tb >= 0.0 && (ta < 0.0 || tb < ta);
+        let t0 = select(ta, tb, b_first);
+        let i0 = select(n.a_index, n.b_index, b_first);
+        let c0 = select(n.a_count, n.b_count, b_first);
+        let t1 = select(tb, ta, b_first);
+        let i1 = select(n.b_index, n.a_index, b_first);
+        let c1 = select(n.b_count, n.a_count, b_first);
+        var next = NO_HIT;
+        if (t0 >= 0.0) {
+            if (c0 > 0u) {
+                hit = leaf_closest(i0, c0, r, hit);
+            } else {
+                next = i0;
+            }
+        }
+        // Re-check the far child: a leaf of the near one may have moved hit.t closer.
+        if (t1 >= 0.0 && t1 <= hit.t) {
+            if (c1 > 0u) {
+                hit = leaf_closest(i1, c1, r, hit);
+            } else if (next == NO_HIT) {
+                next = i1;
+            } else {
+                stack[sp] = i1;
+                sp += 1u;
+            }
+        }
+        if (next == NO_HIT) {
+            if (sp == 0u) {
+                break;
+            }
+            sp -= 1u;
+            next = stack[sp];
+        }
+        node = next;
+    }
+    return hit;
+}
+
+// Whether some triangle is hit with 0 < t < tmax (occlusion); returns at the first.
+fn trace_any(origin: vec3<f32>, dir: vec3<f32>, tmax: f32) -> bool {
+    if (all(dir == vec3<f32>(0.0))) {
+        return false;
+    }
+    let r = make_ray(origin, dir);
+    var stack: array<u32, STACK_SIZE>;
+    var sp = 0u;
+    var node = 0u;
+    loop {
+        let n = bvh_nodes[node];
+        let ta = box_near(n.a_min, n.a_max, r, tmax);
+        let tb = box_near(n.b_min, n.b_max, r, tmax);
+        let b_first = tb >= 0.0 && (ta < 0.0 || tb < ta);
+        let t0 = select(ta, tb, b_first);
+        let i0 = select(n.a_index, n.b_index, b_first);
+        let c0 = select(n.a_count, n.b_count, b_first);
+        let t1 = select(tb, ta, b_first);
+        let i1 = select(n.b_index, n.a_index, b_first);
+        let c1 = select(n.b_count, n.a_count, b_first);
+        var next = NO_HIT;
+        if (t0 >= 0.0) {
+            if (c0 > 0u) {
+                if (leaf_any(i0, c0, r, tmax)) {
+                    return true;
+                }
+            } else {
+                next = i0;
+            }
+        }
+        if (t1 >= 0.0) {
+            if (c1 > 0u) {
+                if (leaf_any(i1, c1, r, tmax)) {
+                    return true;
+                }
+            } else if (next == NO_HIT) {
+                next = i1;
+            } else {
+                stack[sp] = i1;
+                sp += 1u;
+            }
+        }
+        if (next == NO_HIT) {
+            if (sp == 0u) {
+                return false;
+            }
+            sp -= 1u;
+            next = stack[sp];
+        }
+        node = next;
+    }
+    return false;
+}
+
+// Origin for a ray leaving a surface at p, n the unit geometric normal on the side the
+// ray leaves to: each coordinate moves by 256 n_i ulps of itself (integer add on its
+// bits), or by n_i / 65536 within 1/32 of 0. Bit for bit igi_core::bvh::offset_ray_origin.
+fn offset_ray_origin(p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+    let of_i = vec3<i32>(OFFSET_INT_SCALE * n);
+    let p_i = bitcast<vec3<f32>>(bitcast<vec3<i32>>(p) + select(of_i, -of_i, p < vec3<f32>(0.0)));
+    return select(p_i, p + OFFSET_FLOAT_SCALE * n, abs(p) < vec3<f32>(OFFSET_ORIGIN));
+}
+
+// Shadow ray from surface point x (normal nx) to surface point y (normal ny), both ends
+// offset along their normals turned toward the other point. Trace it with tmax = 1: dir
+// is y' - x', not normalised, so t is in units of the segment.
+fn shadow_segment(x: vec3<f32>, nx: vec3<f32>, y: vec3<f32>, ny: vec3<f32>) -> ShadowSegment {
+    let d = y - x;
+    let ox = offset_ray_origin(x, select(nx, -nx, dot(nx, d) < 0.0));
+    let oy = offset_ray_origin(y, select(ny, -ny, dot(ny, d) > 0.0));
+    return ShadowSegment(ox, oy - ox);
+}

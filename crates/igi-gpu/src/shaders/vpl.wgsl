@@ -1,0 +1,134 @@
+// vpl.wgsl: VPL shooting (paper section 4, first stage). One thread per light path: a
+// particle leaves a point light (chosen in proportion to power), and at every hit on a
+// surface with a diffuse part stores a VPL carrying the particle's flux; it continues by
+// Russian roulette on the mean albedo (diffuse bounce or mirror reflection), up to B
+// stored VPLs. Path i is driven by Halton index halton_base + i: dimension 0 picks the
+// light, 1-2 the emission direction, then 3 per segment (direction u, v; continuation).
+// A second entry point compacts the per-path slots into a dense, deterministic VPL list.
+
+@group(1) @binding(1) var<storage, read_write> vpl_slots: array<Vpl>;
+@group(1) @binding(2) var<storage, read_write> vpls: array<Vpl>;
+@group(1) @binding(3) var<storage, read_write> vpl_header: VplHeader;
+
+const SHOOT_GROUP: u32 = 64u;
+
+fn light_power_weight(l: u32) -> f32 {
+    let i = lights[l].intensity;
+    return 4.0 * PI * (i.x + i.y + i.z);
+}
+
+@compute @workgroup_size(64)
+fn shoot(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    let path = gid.x + gid.y * groups.x * SHOOT_GROUP;
+    if (path >= params.path_count) {
+        return;
+    }
+    let index = params.halton_base + path;
+    let first_slot = path * params.bounces;
+
+    // Light choice in proportion to power: flux = Phi_l / (p_l M) = total / M for grey
+    // lights, and exact per channel for coloured ones.
+    var u = halton(0u, index) * params.light_power_sum;
+    var chosen = params.light_count - 1u;
+    for (var l = 0u; l < params.light_count; l += 1u) {
+        let w = light_power_weight(l);
+        if (u < w) {
+            chosen = l;
+            break;
+        }
+        u -= w;
+    }
+    let light = lights[chosen];
+    let p_light = light_power_weight(chosen) / params.light_power_sum;
+    var flux = 4.0 * PI * light.intensity / (p_light * f32(params.path_count));
+
+    var origin = light.position;
+    var dir = uniform_sphere(halton(1u, index), halton(2u, index));
+    var stored = 0u;
+    var dim = 3u;
+    // Mirror reflections store nothing, so the walk is bounded separately.
+    let max_segments = params.bounces + params.mirror_depth;
+    for (var segment = 0u; segment < max_segments; segment += 1u) {
+        let hit = trace_closest(origin, dir, INFINITY);
+        if (hit.tri == NO_HIT) {
+            break;
+        }
+        let s = surface_at(origin, dir, hit);
+        if (max(s.diffuse.x, max(s.diffuse.y, s.diffuse.z)) > 0.0) {
+            var v: Vpl;
+            v.position = s.position;
+            v.valid = 1u;
+            v.normal = s.shading_normal;
+            v.bounce = stored + 1u;
+            v.flux = flux;
+            v.albedo = s.diffuse;
+            vpl_slots[first_slot + stored] = v;
+            stored += 1u;
+            if (stored == params.bounces) {
+                break;
+            }
+        }
+        // Continue diffusely with probability mean(rho_d), by the mirror with mean(rho_m).
+        let p_diffuse = mean3(s.diffuse);
+        let p_mirror = mean3(s.mirror);
+        let choice = halton(dim + 2u, index);
+        if (choice < p_diffuse) {
+            let local = cosine_hemisphere(halton(dim, index), halton(dim + 1u, index));
+            let n = s.shading_normal;
+            dir = local.x * basis_t(n) + local.y * basis_b(n) + local.z * n;
+            if (dot(dir, s.geometric_normal) <= 0.0) {
+                break;
+            }
+            flux *= s.diffuse / p_diffuse;
+        } else if (choice < p_diffuse + p_mirror) {
+            dir = reflect(dir, s.shading_normal);
+            if (dot(dir, s.geometric_normal) <= 0.0) {
+                dir = reflect(dir, s.geometric_normal);
+            }
+            flux *= s.mirror / p_mirror;
+        } else {
+            break;
+        }
+        origin = offset_ray_origin(s.position, s.geometric_normal);
+        dim += 3u;
+    }
+    // Slots this path did not fill are marked empty for compaction.
+    for (var k = stored; k < params.bounces; k += 1u) {
+        vpl_slots[first_slot + k].valid = 0u;
+    }
+}
+
+const COMPACT_GROUP: u32 = 256u;
+var<workgroup> chunk_counts: array<u32, 256>;
+
+// One workgroup: each thread counts the valid slots of a contiguous chunk, a prefix sum
+// over the chunk counts gives each chunk's output offset, then each thread copies its
+// chunk. Slot order is kept, so the VPL list is the same on every run.
+@compute @workgroup_size(256)
+fn compact(@builtin(local_invocation_index) t: u32) {
+    let slots = params.path_count * params.bounces;
+    let chunk = (slots + COMPACT_GROUP - 1u) / COMPACT_GROUP;
+    let begin = min(t * chunk, slots);
+    let end = min(begin + chunk, slots);
+    var count = 0u;
+    for (var s = begin; s < end; s += 1u) {
+        count += vpl_slots[s].valid;
+    }
+    chunk_counts[t] = count;
+    workgroupBarrier();
+    var offset = 0u;
+    for (var i = 0u; i < t; i += 1u) {
+        offset += chunk_counts[i];
+    }
+    for (var s = begin; s < end; s += 1u) {
+        if (vpl_slots[s].valid != 0u) {
+            vpls[offset] = vpl_slots[s];
+            offset += 1u;
+        }
+    }
+    if (t == COMPACT_GROUP - 1u) {
+        vpl_header.count = offset;
+        vpl_header.path_count = params.path_count;
+        vpl_header.slots = slots;
+    }
+}

@@ -1,0 +1,109 @@
+//! Every composed shader parses and validates with naga (a broken shader fails here, not
+//! in front of a user), and every host/GPU struct has the size and field offsets that
+//! the WGSL declares.
+
+use igi_gpu::layout::{BvhNode, FrameParams, GpuLight, GpuMaterial, TriShading, Vpl};
+use std::mem::{offset_of, size_of};
+
+fn parse_and_validate(name: &str, src: &str) -> naga::Module {
+    let module = naga::front::wgsl::parse_str(src)
+        .unwrap_or_else(|e| panic!("{name}.wgsl does not parse:\n{}", e.emit_to_string(src)));
+    naga::valid::Validator::new(
+        naga::valid::ValidationFlags::all(),
+        naga::valid::Capabilities::default(),
+    )
+    .validate(&module)
+    .unwrap_or_else(|e| panic!("{name}.wgsl does not validate:\n{}", e.emit_to_string(src)));
+    module
+}
+
+#[test]
+fn every_pass_shader_validates() {
+    let shaders = igi_gpu::shader::all_shaders();
+    assert!(shaders.len() >= 4);
+    for (name, src) in shaders {
+        parse_and_validate(name, &src);
+    }
+}
+
+/// (size, [(member name, offset)]) of the WGSL struct `name`.
+fn wgsl_layout(module: &naga::Module, name: &str) -> (u32, Vec<(String, u32)>) {
+    let mut layouter = naga::proc::Layouter::default();
+    layouter.update(module.to_ctx()).unwrap();
+    for (handle, ty) in module.types.iter() {
+        if ty.name.as_deref() == Some(name) {
+            if let naga::TypeInner::Struct { members, span } = &ty.inner {
+                let _ = layouter[handle];
+                return (
+                    *span,
+                    members
+                        .iter()
+                        .map(|m| (m.name.clone().unwrap_or_default(), m.offset))
+                        .collect(),
+                );
+            }
+        }
+    }
+    panic!("no struct {name} in the WGSL");
+}
+
+macro_rules! check_layout {
+    ($module:expr, $wgsl:literal, $rust:ty, [$($field:ident),* $(,)?]) => {{
+        let (size, members) = wgsl_layout($module, $wgsl);
+        assert_eq!(size as usize, size_of::<$rust>(), "size of {}", $wgsl);
+        $(
+            let offset = members
+                .iter()
+                .find(|(n, _)| n == stringify!($field))
+                .unwrap_or_else(|| panic!("{} has no member {}", $wgsl, stringify!($field)))
+                .1;
+            assert_eq!(offset as usize, offset_of!($rust, $field), "{}.{}", $wgsl, stringify!($field));
+        )*
+    }};
+}
+
+#[test]
+fn host_structs_match_wgsl() {
+    let (name, src) = igi_gpu::shader::all_shaders().remove(0);
+    let module = parse_and_validate(name, &src);
+    check_layout!(
+        &module,
+        "BvhNode",
+        BvhNode,
+        [a_min, a_index, a_max, a_count, b_min, b_index, b_max, b_count]
+    );
+    check_layout!(&module, "TriShading", TriShading, [n0, material, n1, n2]);
+    check_layout!(&module, "Material", GpuMaterial, [diffuse, mirror]);
+    check_layout!(&module, "PointLight", GpuLight, [position, intensity]);
+    check_layout!(
+        &module,
+        "Vpl",
+        Vpl,
+        [position, valid, normal, bounce, flux, albedo]
+    );
+    check_layout!(
+        &module,
+        "FrameParams",
+        FrameParams,
+        [
+            cam_eye,
+            width,
+            cam_forward,
+            height,
+            cam_right,
+            tan_half_fov_y,
+            cam_up,
+            aspect,
+            total_power,
+            light_count,
+            path_count,
+            bounces,
+            min_dist,
+            geometry_bound,
+            mirror_depth,
+            halton_base,
+            output,
+            light_power_sum
+        ]
+    );
+}

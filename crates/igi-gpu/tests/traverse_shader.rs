@@ -1,0 +1,119 @@
+//! traverse.wgsl (the GPU ray-tracing layer that replaces OptiX in Marques and Santos'
+//! IGI) parses and validates with naga, composed as every tracing pass composes it, and
+//! its constants agree with the CPU builder and traversal of igi-core.
+
+use naga::valid::{Capabilities, ValidationFlags, Validator};
+
+const SCENE: &str = include_str!("../src/shaders/scene.wgsl");
+const TRAVERSE: &str = include_str!("../src/shaders/traverse.wgsl");
+
+/// A kernel that calls every public function of traverse.wgsl.
+const KERNEL: &str = r#"
+@group(1) @binding(0) var<storage, read_write> out: array<vec4<f32>>;
+
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let o = vec3<f32>(f32(gid.x), 0.5, -3.0);
+    let h = trace_closest(o, vec3<f32>(0.0, 0.0, 1.0), 1e30);
+    let a = trace_any(o, vec3<f32>(0.0, 1.0, 0.0), 1.0);
+    let p = offset_ray_origin(o, vec3<f32>(0.0, 1.0, 0.0));
+    let s = shadow_segment(o, vec3<f32>(0.0, 1.0, 0.0), p, vec3<f32>(1.0, 0.0, 0.0));
+    out[gid.x] = vec4<f32>(h.t + f32(h.tri) + h.u + h.v, select(0.0, 1.0, a), p.x + s.origin.y, s.dir.z);
+}
+"#;
+
+fn parse_and_validate(src: &str) -> naga::Module {
+    let module = naga::front::wgsl::parse_str(src)
+        .unwrap_or_else(|e| panic!("does not parse:\n{}", e.emit_to_string(src)));
+    Validator::new(ValidationFlags::all(), Capabilities::all())
+        .validate(&module)
+        .unwrap_or_else(|e| panic!("does not validate:\n{}", e.emit_to_string(src)));
+    // Also without optional capabilities: traverse.wgsl must need none.
+    Validator::new(ValidationFlags::all(), Capabilities::default())
+        .validate(&module)
+        .unwrap_or_else(|e| panic!("needs an optional capability:\n{}", e.emit_to_string(src)));
+    module
+}
+
+fn composed() -> String {
+    [SCENE, TRAVERSE, KERNEL].join("\n")
+}
+
+#[test]
+fn traverse_wgsl_validates() {
+    parse_and_validate(&composed());
+}
+
+#[test]
+fn traverse_wgsl_matches_the_shared_module() {
+    // The shader assembly of igi-gpu composes the same file.
+    assert_eq!(igi_gpu::shader::TRAVERSE, TRAVERSE);
+}
+
+/// The value of a scalar `const` of the module.
+fn constant(module: &naga::Module, name: &str) -> naga::Literal {
+    let (_, c) = module
+        .constants
+        .iter()
+        .find(|(_, c)| c.name.as_deref() == Some(name))
+        .unwrap_or_else(|| panic!("no const {name}"));
+    match module.global_expressions[c.init] {
+        naga::Expression::Literal(l) => l,
+        ref e => panic!("const {name} is not a literal: {e:?}"),
+    }
+}
+
+#[test]
+fn constants_match_the_cpu_twin() {
+    let module = parse_and_validate(&composed());
+    assert_eq!(
+        constant(&module, "STACK_SIZE"),
+        naga::Literal::U32(igi_core::bvh::MAX_DEPTH),
+        "the traversal stack must hold MAX_DEPTH entries"
+    );
+    assert_eq!(
+        constant(&module, "NO_HIT"),
+        naga::Literal::U32(igi_core::bvh::NO_HIT)
+    );
+    let f = |name: &str| match constant(&module, name) {
+        naga::Literal::F32(x) => x,
+        l => panic!("{name}: {l:?}"),
+    };
+    // The bits the CPU uses (igi-core/src/bvh/traverse.rs).
+    assert_eq!(
+        f("BOX_TFAR_SCALE").to_bits(),
+        1.000_000_357_627_868_7f32.to_bits()
+    );
+    assert_eq!(f("BOX_TFAR_SCALE"), 1.0 + 3.0 * f32::EPSILON);
+    assert_eq!(f("DIR_EPS"), 1e-30);
+    assert_eq!(f("PARALLEL_INV"), 1e30);
+    assert_eq!(f("FAR_BIG"), 1e38);
+    assert_eq!(f("OFFSET_ORIGIN"), 1.0 / 32.0);
+    assert_eq!(f("OFFSET_FLOAT_SCALE"), 1.0 / 65536.0);
+    assert_eq!(f("OFFSET_INT_SCALE"), 256.0);
+}
+
+#[test]
+fn hit_is_16_bytes_like_the_cpu_hit() {
+    let module = parse_and_validate(&composed());
+    let mut layouter = naga::proc::Layouter::default();
+    layouter.update(module.to_ctx()).unwrap();
+    let (handle, ty) = module
+        .types
+        .iter()
+        .find(|(_, t)| t.name.as_deref() == Some("Hit"))
+        .expect("struct Hit");
+    let naga::TypeInner::Struct { members, span } = &ty.inner else {
+        panic!("Hit is not a struct")
+    };
+    assert_eq!(layouter[handle].size, 16);
+    assert_eq!(*span as usize, std::mem::size_of::<igi_core::bvh::Hit>());
+    let offsets: Vec<(String, u32)> = members
+        .iter()
+        .map(|m| (m.name.clone().unwrap_or_default(), m.offset))
+        .collect();
+    assert_eq!(
+        offsets,
+        [("t", 0), ("tri", 4), ("u", 8), ("v", 12)].map(|(n, o)| (n.to_string(), o))
+    );
+}

@@ -1,0 +1,200 @@
+//! The `igi` command as a user meets it: bad input gives one clear error line naming the
+//! file (and line where known) and a non-zero exit, never a panic; good input renders.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn igi(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_igi"))
+        .args(args)
+        .env(
+            "XDG_RUNTIME_DIR",
+            std::env::var("XDG_RUNTIME_DIR").unwrap_or("/tmp".into()),
+        )
+        .output()
+        .expect("run igi")
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("igi-cli-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// The run failed with exactly one line on stderr that contains every `needle`.
+fn assert_one_error_line(out: &Output, needles: &[&str]) {
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success(),
+        "expected failure, got success; stderr: {stderr}"
+    );
+    assert!(!stderr.contains("panicked"), "panic: {stderr}");
+    let lines: Vec<&str> = stderr.lines().filter(|l| l.starts_with("error")).collect();
+    assert_eq!(lines.len(), 1, "one error line expected, got: {stderr}");
+    for n in needles {
+        assert!(lines[0].contains(n), "'{}' does not name '{n}'", lines[0]);
+    }
+}
+
+const CAMERA: &str = "[camera]\neye = [0.0, 1.0, 3.0]\ntarget = [0.0, 1.0, 0.0]\nup = [0.0, 1.0, 0.0]\nfov_y_deg = 40.0\n[film]\nwidth = 16\nheight = 16\n";
+const LIGHT: &str = "[[point_light]]\nposition = [0.0, 1.5, 0.0]\nintensity = [1.0, 1.0, 1.0]\n";
+const QUAD: &str = "v -1 0 -1\nv 1 0 -1\nv 1 0 1\nv -1 0 1\nf 1 2 3 4\n";
+
+fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+fn scene_with_obj(dir: &Path, obj: &str) -> PathBuf {
+    write(dir, "mesh.obj", obj);
+    write(
+        dir,
+        "scene.toml",
+        &format!("{CAMERA}[[mesh]]\npath = \"mesh.obj\"\ndefault_material = \"grey\"\n{LIGHT}[materials.grey]\ndiffuse = [0.5, 0.5, 0.5]\n"),
+    )
+}
+
+#[test]
+fn missing_scene_file() {
+    let out = igi(&["render", "/no/such/scene.toml", "-o", "/tmp/x.png"]);
+    assert_one_error_line(&out, &["/no/such/scene.toml"]);
+}
+
+#[test]
+fn toml_syntax_error_names_file_and_line() {
+    let d = temp_dir("syntax");
+    let p = write(
+        &d,
+        "broken.toml",
+        &format!("{CAMERA}[[mesh]\npath = \"m.obj\"\n"),
+    );
+    let out = igi(&[
+        "render",
+        p.to_str().unwrap(),
+        "-o",
+        d.join("x.png").to_str().unwrap(),
+    ]);
+    assert_one_error_line(&out, &["broken.toml", "9"]);
+}
+
+#[test]
+fn missing_obj_is_named() {
+    let d = temp_dir("missing-obj");
+    let p = write(
+        &d,
+        "scene.toml",
+        &format!("{CAMERA}[[mesh]]\npath = \"nowhere.obj\"\n{LIGHT}"),
+    );
+    let out = igi(&[
+        "render",
+        p.to_str().unwrap(),
+        "-o",
+        d.join("x.png").to_str().unwrap(),
+    ]);
+    assert_one_error_line(&out, &["nowhere.obj"]);
+}
+
+#[test]
+fn obj_index_out_of_range_names_file_and_line() {
+    let d = temp_dir("index");
+    let p = scene_with_obj(&d, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 9\n");
+    let out = igi(&[
+        "render",
+        p.to_str().unwrap(),
+        "-o",
+        d.join("x.png").to_str().unwrap(),
+    ]);
+    assert_one_error_line(&out, &["mesh.obj", "5"]);
+    assert!(!d.join("x.png").exists(), "no output after an error");
+}
+
+#[test]
+fn output_in_missing_directory() {
+    let d = temp_dir("outdir");
+    let p = scene_with_obj(&d, QUAD);
+    let out = igi(&[
+        "render",
+        p.to_str().unwrap(),
+        "-o",
+        d.join("no/such/dir/x.png").to_str().unwrap(),
+    ]);
+    assert_one_error_line(&out, &["no/such/dir"]);
+}
+
+#[test]
+fn unknown_builtin() {
+    let out = igi(&["render", "--builtin", "teapot", "-o", "/tmp/x.png"]);
+    assert_one_error_line(&out, &["teapot", "cornell-box"]);
+}
+
+#[test]
+fn renders_builtin_cornell_box_to_png_and_exr() {
+    let d = temp_dir("builtin");
+    let png = d.join("box.png");
+    let exr = d.join("box.exr");
+    let out = igi(&[
+        "render",
+        "--builtin",
+        "cornell-box",
+        "--width",
+        "64",
+        "--height",
+        "64",
+        "--vpls",
+        "30",
+        "--timings",
+        "-o",
+        png.to_str().unwrap(),
+        "--exr",
+        exr.to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    if stderr.contains("no GPU adapter") {
+        eprintln!("skipped: {stderr}");
+        return;
+    }
+    assert!(out.status.success(), "{stderr}");
+    assert!(stderr.contains("VPLs from"), "{stderr}");
+    let image = igi_core::image::Image::read_exr(&exr).unwrap();
+    assert_eq!((image.width, image.height), (64, 64));
+    let mean = image.mean();
+    assert!(
+        mean.iter().all(|&m| m > 0.01 && m.is_finite()),
+        "mean {mean:?}"
+    );
+    assert!(std::fs::metadata(&png).unwrap().len() > 100);
+}
+
+#[test]
+fn info_lists_adapters() {
+    let out = igi(&["info"]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    if out.status.success() {
+        assert!(stdout.contains("igi would use adapter"), "{stdout}");
+    } else {
+        assert!(stderr.contains("mesa-vulkan-drivers"), "{stderr}");
+    }
+}
+
+#[test]
+fn no_adapter_says_what_to_install() {
+    // Point the Vulkan loader at no driver and allow only Vulkan: no adapter at all.
+    let out = Command::new(env!("CARGO_BIN_EXE_igi"))
+        .args([
+            "render",
+            "--builtin",
+            "cornell-box",
+            "-o",
+            "/tmp/igi-no-adapter.png",
+        ])
+        .env("XDG_RUNTIME_DIR", "/tmp")
+        .env("WGPU_BACKEND", "vulkan")
+        .env("VK_DRIVER_FILES", "/nonexistent/icd.json")
+        .env("VK_ICD_FILENAMES", "/nonexistent/icd.json")
+        .output()
+        .unwrap();
+    assert_one_error_line(&out, &["mesa-vulkan-drivers"]);
+}
