@@ -57,7 +57,9 @@ fn main() {
         times.push(t.elapsed().as_secs_f64() * 1e3);
         bvh = Some(b);
     }
-    let cpu = process_cpu_seconds().zip(cpu_start).map(|(b, a)| (b - a) / runs as f64);
+    let cpu = process_cpu_seconds()
+        .zip(cpu_start)
+        .map(|(b, a)| (b - a) / runs as f64);
     let bvh = bvh.expect("at least one run");
     times.sort_by(f64::total_cmp);
     let s = &bvh.build_stats;
@@ -124,7 +126,13 @@ fn load_obj(path: &std::path::Path) -> Vec<Triangle> {
     let mut out = vec![];
     for m in models {
         let p = &m.mesh.positions;
-        let v = |i: u32| Vec3::new(p[3 * i as usize], p[3 * i as usize + 1], p[3 * i as usize + 2]);
+        let v = |i: u32| {
+            Vec3::new(
+                p[3 * i as usize],
+                p[3 * i as usize + 1],
+                p[3 * i as usize + 2],
+            )
+        };
         for f in m.mesh.indices.chunks_exact(3) {
             let v = [v(f[0]), v(f[1]), v(f[2])];
             let n = (v[1] - v[0]).cross(v[2] - v[0]).normalize_or_zero();

@@ -48,6 +48,31 @@ impl Image {
         self.data[(y * self.width + x) as usize]
     }
 
+    /// The image averaged over f x f blocks (a box filter, as the references' pixels are);
+    /// edge blocks average what they hold.
+    pub fn downsample_box(&self, f: u32) -> Image {
+        let f = f.max(1);
+        let (w, h) = (self.width.div_ceil(f), self.height.div_ceil(f));
+        let mut out = Image::new(w, h);
+        for y in 0..h {
+            for x in 0..w {
+                let mut sum = [0.0f64; 3];
+                let mut n = 0.0;
+                for yy in y * f..((y + 1) * f).min(self.height) {
+                    for xx in x * f..((x + 1) * f).min(self.width) {
+                        let p = self.pixel(xx, yy);
+                        for c in 0..3 {
+                            sum[c] += p[c] as f64;
+                        }
+                        n += 1.0;
+                    }
+                }
+                out.data[(y * w + x) as usize] = sum.map(|v| (v / n) as f32);
+            }
+        }
+        out
+    }
+
     /// Mean of each channel.
     pub fn mean(&self) -> [f64; 3] {
         let mut m = [0.0f64; 3];
@@ -223,6 +248,15 @@ mod tests {
             .collect();
         assert!(leftovers.is_empty());
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn box_downsampling_averages_blocks() {
+        let mut a = Image::new(3, 2);
+        a.data = vec![[1.0; 3], [3.0; 3], [5.0; 3], [3.0; 3], [5.0; 3], [7.0; 3]];
+        let d = a.downsample_box(2);
+        assert_eq!((d.width, d.height), (2, 1));
+        assert_eq!(d.data, vec![[3.0; 3], [6.0; 3]]);
     }
 
     #[test]

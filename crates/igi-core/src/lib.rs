@@ -7,6 +7,7 @@
 
 pub mod bvh;
 pub mod image;
+pub mod metrics;
 pub mod sampling;
 pub mod scene;
 pub mod settings;

@@ -28,6 +28,100 @@ pub enum OutputBuffer {
     Irradiance,
 }
 
+/// How interleaved sampling assigns VPL subsets to the pixels of a tile (paper section 4.3
+/// and its future work).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum InterleavePattern {
+    /// Pixel (x, y) of every tile gathers subset (x mod n) + n (y mod m), as in the paper.
+    #[default]
+    Regular,
+    /// Each tile permutes the subsets (a seeded permutation per tile), against the visible
+    /// repetition of the regular pattern.
+    Irregular,
+}
+
+/// How the interleaved, downsampled indirect term is filtered back to full resolution.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum FilterMode {
+    /// Discontinuity buffer at the indirect resolution, then joint bilateral upsampling.
+    #[default]
+    TwoPass,
+    /// One pass doing both (the paper's future work).
+    Fused,
+}
+
+/// The paper's accelerations (sections 4.1 to 4.3) and their filter parameters.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Accelerations {
+    /// VPL shadow rays test triangle bounding boxes instead of triangles (section 4.1).
+    pub imperfect_visibility: bool,
+    /// Indirect light at 1/downsample of the resolution per axis (section 4.2); 1 = off.
+    pub downsample: u32,
+    /// Interleaved sampling over n x m VPL subsets (section 4.3); (1, 1) = off.
+    pub interleave: (u32, u32),
+    pub pattern: InterleavePattern,
+    pub filter: FilterMode,
+    /// Standard deviation of the upsampler's spatial Gaussian, in low-resolution pixels.
+    pub upsample_sigma: f32,
+    /// Exponent of the upsampler's normal weight (N_p . N_q)^k; the paper's plain cosine is 1.
+    pub upsample_normal_power: f32,
+    /// Whether depth joins the upsampler's range weight (not in the paper).
+    pub upsample_depth: bool,
+    /// Relative depth difference beyond which a neighbour is discontinuous (filters).
+    pub depth_threshold: f32,
+    /// Smallest normal dot product for a neighbour to count as continuous (filters).
+    pub normal_threshold: f32,
+}
+
+impl Default for Accelerations {
+    fn default() -> Self {
+        Accelerations {
+            imperfect_visibility: false,
+            downsample: 1,
+            interleave: (1, 1),
+            pattern: InterleavePattern::Regular,
+            filter: FilterMode::TwoPass,
+            upsample_sigma: 1.0,
+            upsample_normal_power: 1.0,
+            upsample_depth: true,
+            depth_threshold: 0.1,
+            normal_threshold: 0.9,
+        }
+    }
+}
+
+impl Accelerations {
+    /// The paper's four set-ups by name: "canonical", and any of "iv", "ds", "il" joined
+    /// by '+' (e.g. "iv+ds+il"), with the paper's parameters (downsample 4, interleave
+    /// 3x3); "irregular" and "fused" switch the pattern and the filter.
+    pub fn from_setup(name: &str) -> Result<Accelerations, String> {
+        let mut a = Accelerations::default();
+        if name == "canonical" {
+            return Ok(a);
+        }
+        for part in name.split('+') {
+            match part {
+                "iv" => a.imperfect_visibility = true,
+                "ds" => a.downsample = 4,
+                "il" => a.interleave = (3, 3),
+                "irregular" => a.pattern = InterleavePattern::Irregular,
+                "fused" => a.filter = FilterMode::Fused,
+                other => {
+                    return Err(format!(
+                        "unknown set-up part '{other}' in '{name}' (use canonical, or iv, ds, il, irregular, fused joined by +)"
+                    ))
+                }
+            }
+        }
+        Ok(a)
+    }
+
+    /// Whether the indirect term goes through a filter at all.
+    pub fn filtered(&self) -> bool {
+        self.downsample > 1 || self.interleave != (1, 1)
+    }
+}
+
 /// Everything that decides what a frame computes (not where it goes).
 #[derive(Clone, Debug, PartialEq)]
 pub struct RenderSettings {
@@ -49,6 +143,9 @@ pub struct RenderSettings {
     pub frame: u32,
     pub exposure: f32,
     pub output: OutputBuffer,
+    pub accelerations: Accelerations,
+    /// Frames averaged into the image, each with a fresh VPL set (1 = one frame).
+    pub accumulate: u32,
 }
 
 impl Default for RenderSettings {
@@ -65,6 +162,8 @@ impl Default for RenderSettings {
             frame: 0,
             exposure: 1.0,
             output: OutputBuffer::Final,
+            accelerations: Accelerations::default(),
+            accumulate: 1,
         }
     }
 }

@@ -2,7 +2,10 @@
 //! paths with the same Halton dimensions, used by tests to check the GPU pass.
 
 use crate::bvh::{offset_ray_origin, Bvh};
-use crate::sampling::{cosine_hemisphere, halton, orthonormal_basis, uniform_sphere};
+use crate::sampling::{
+    cosine_hemisphere, orthonormal_basis, scrambled_radical_inverse, uniform_sphere,
+    DigitPermutations,
+};
 use crate::scene::Scene;
 use glam::Vec3;
 use std::f32::consts::PI;
@@ -57,16 +60,19 @@ fn mean3(v: Vec3) -> f32 {
     (v.x + v.y + v.z) / 3.0
 }
 
-/// Shoot `paths` light paths from Halton index `base` on, storing at most `bounces` VPLs
-/// per path, in path order (the order of the GPU's compacted list).
+/// Shoot `paths` light paths from index `base` of the Halton sequence scrambled with
+/// `perms`, storing at most `bounces` VPLs per path, in path order (the order of the
+/// GPU's compacted list).
 pub fn shoot_vpls(
     scene: &Scene,
     bvh: &Bvh,
+    perms: &DigitPermutations,
     paths: u32,
     bounces: u32,
     mirror_depth: u32,
     base: u32,
 ) -> Vec<CpuVpl> {
+    let halton = |dim: usize, index: u32| scrambled_radical_inverse(perms, dim, index);
     let weight = |l: usize| 4.0 * PI * scene.lights[l].intensity.element_sum();
     let power_sum: f32 = (0..scene.lights.len()).map(weight).sum();
     let mut out = vec![];

@@ -7,19 +7,23 @@ use crate::context::{GpuContext, GpuError};
 use crate::layout::{FrameParams, Vpl};
 use crate::passes::compose::ComposePass;
 use crate::passes::direct::{DirectBindings, DirectPass};
-use crate::passes::{dispatch, gather_range_layout, GatherRanges, GATHER_RANGE_STRIDE};
+use crate::passes::filter::{Filter, FilterPass};
 use crate::passes::indirect::IndirectPass;
 use crate::passes::vpl::VplPass;
+use crate::passes::{dispatch, gather_range_layout, GatherRanges, GATHER_RANGE_STRIDE};
 use crate::profiler::{Profiler, StageTime};
 use crate::scene_buffers::SceneBuffers;
 use igi_core::bvh::Bvh;
 use igi_core::image::Image;
-use igi_core::sampling::{halton_base, pilot_base};
+use igi_core::sampling::{halton_base, pilot_base, DigitPermutations};
 use igi_core::scene::{Camera, Scene};
-use igi_core::settings::{GeometryBound, OutputBuffer, RenderSettings};
+use igi_core::settings::{
+    Accelerations, FilterMode, GeometryBound, InterleavePattern, OutputBuffer, RenderSettings,
+};
 
-/// The stages of a frame, in order; the index is the stage's timestamp pair.
-pub const STAGES: [&str; 4] = ["vpl shooting", "direct + specular", "indirect", "compose"];
+/// Most stages a frame can have (vpl, direct, indirect, two filters, compose), each
+/// with its timestamp pair.
+pub const MAX_STAGES: u32 = 6;
 
 /// Light paths of the pilot run that estimates VPLs per path.
 pub const PILOT_PATHS: u32 = 4096;
@@ -48,7 +52,12 @@ struct ImageBuffers {
     normal: wgpu::Buffer,
     geometric: wgpu::Buffer,
     albedo: wgpu::Buffer,
+    /// E at the indirect resolution, as the indirect pass leaves it.
     irradiance: wgpu::Buffer,
+    /// After the discontinuity buffer (indirect resolution).
+    filtered_low: wgpu::Buffer,
+    /// After upsampling or the fused filter (full resolution).
+    filtered: wgpu::Buffer,
     color: wgpu::Buffer,
 }
 
@@ -64,10 +73,13 @@ pub struct Renderer {
     vpl: VplPass,
     direct: DirectPass,
     indirect: IndirectPass,
+    filter: FilterPass,
     compose: ComposePass,
     profiler: Profiler,
     params: wgpu::Buffer,
     vpl_header: wgpu::Buffer,
+    /// The scrambled Halton sequence's digit permutations, for the seed they were made for.
+    halton_perms: (u32, wgpu::Buffer),
     /// Bind group 2 of the gathering passes: the VPL ranges of one frame.
     range_layout: wgpu::BindGroupLayout,
     range_buffer: Option<(wgpu::Buffer, wgpu::BindGroup, u32)>,
@@ -93,7 +105,25 @@ fn storage(device: &wgpu::Device, label: &str, size: u64) -> wgpu::Buffer {
     })
 }
 
+fn permutation_buffer(ctx: &GpuContext, seed: u32) -> wgpu::Buffer {
+    wgpu::util::DeviceExt::create_buffer_init(
+        &ctx.device,
+        &wgpu::util::BufferInitDescriptor {
+            label: Some("halton permutations"),
+            contents: bytemuck::cast_slice(&DigitPermutations::new(seed).table),
+            usage: wgpu::BufferUsages::STORAGE,
+        },
+    )
+}
+
 impl Renderer {
+    /// Digit permutations for `seed` on the GPU (made again only when the seed changes).
+    fn ensure_permutations(&mut self, ctx: &GpuContext, seed: u32) {
+        if self.halton_perms.0 != seed {
+            self.halton_perms = (seed, permutation_buffer(ctx, seed));
+        }
+    }
+
     /// Upload the scene and its BVH, and build the passes.
     pub fn new(ctx: &GpuContext, scene: &Scene, bvh: &Bvh) -> Result<Renderer, GpuError> {
         let device = &ctx.device;
@@ -107,9 +137,10 @@ impl Renderer {
             range_layout,
             range_buffer: None,
             vpls_per_dispatch: ctx.vpls_per_dispatch(),
+            filter: FilterPass::new(device, layout),
             compose: ComposePass::new(device, layout),
             scene: scene_buffers,
-            profiler: Profiler::new(ctx, STAGES.len() as u32),
+            profiler: Profiler::new(ctx, MAX_STAGES),
             params: device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("frame params"),
                 size: std::mem::size_of::<FrameParams>() as u64,
@@ -117,6 +148,7 @@ impl Renderer {
                 mapped_at_creation: false,
             }),
             vpl_header: storage(device, "vpl header", 16),
+            halton_perms: (0, permutation_buffer(ctx, 0)),
             images: None,
             vpl_buffers: None,
             camera: scene.camera,
@@ -144,6 +176,8 @@ impl Renderer {
                 &b.geometric,
                 &b.albedo,
                 &b.irradiance,
+                &b.filtered_low,
+                &b.filtered,
                 &b.color,
             ]
             .iter()
@@ -191,6 +225,8 @@ impl Renderer {
             geometric: storage(device, "gbuffer geometric normal", size),
             albedo: storage(device, "gbuffer albedo", size),
             irradiance: storage(device, "irradiance", size),
+            filtered_low: storage(device, "irradiance after discontinuity", size),
+            filtered: storage(device, "irradiance full resolution", size),
             color: storage(device, "color", size),
         });
     }
@@ -220,13 +256,18 @@ impl Renderer {
     fn ensure_ranges(&mut self, ctx: &GpuContext, slots: u64) -> u32 {
         let per = self.vpls_per_dispatch as u64;
         let count = slots.div_ceil(per).max(1) as u32;
-        if self.range_buffer.as_ref().is_none_or(|(_, _, n)| *n != count) {
+        if self
+            .range_buffer
+            .as_ref()
+            .is_none_or(|(_, _, n)| *n != count)
+        {
             let stride = GATHER_RANGE_STRIDE as usize;
             let mut bytes = vec![0u8; count as usize * stride];
             for i in 0..count as usize {
                 let begin = (i as u64 * per).min(u32::MAX as u64) as u32;
                 let end = ((i as u64 + 1) * per).min(u32::MAX as u64) as u32;
-                bytes[i * stride..i * stride + 8].copy_from_slice(bytemuck::cast_slice(&[begin, end]));
+                bytes[i * stride..i * stride + 8]
+                    .copy_from_slice(bytemuck::cast_slice(&[begin, end]));
             }
             let buffer = wgpu::util::DeviceExt::create_buffer_init(
                 &ctx.device,
@@ -253,7 +294,25 @@ impl Renderer {
         count
     }
 
-    fn frame_params(&self, settings: &RenderSettings, paths: u32, base: u32) -> FrameParams {
+    fn frame_params(
+        &self,
+        settings: &RenderSettings,
+        paths: u32,
+        base: u32,
+        accumulate_index: u32,
+    ) -> FrameParams {
+        let a = &settings.accelerations;
+        let low = low_resolution(settings);
+        // Frame 0 through pixel centres (the canonical image); later accumulated frames
+        // at (2, 3) Halton points within the pixel.
+        let jitter = if accumulate_index == 0 {
+            (0.0, 0.0)
+        } else {
+            (
+                igi_core::sampling::radical_inverse(2, accumulate_index) - 0.5,
+                igi_core::sampling::radical_inverse(3, accumulate_index) - 0.5,
+            )
+        };
         let cam = &self.camera;
         let forward = (cam.target - cam.eye).normalize();
         let right = forward.cross(cam.up).normalize();
@@ -288,7 +347,25 @@ impl Renderer {
                 OutputBuffer::Irradiance => 3,
             },
             light_power_sum: self.light_power_sum,
-            _pad: [0; 4],
+            low_width: low.0,
+            low_height: low.1,
+            downsample: a.downsample.max(1),
+            interleave_n: a.interleave.0.max(1),
+            interleave_m: a.interleave.1.max(1),
+            pattern: match a.pattern {
+                InterleavePattern::Regular => 0,
+                InterleavePattern::Irregular => 1,
+            },
+            seed: settings.seed,
+            accumulate_index: accumulate_index,
+            upsample_sigma: a.upsample_sigma,
+            normal_power: a.upsample_normal_power,
+            upsample_depth: a.upsample_depth as u32,
+            depth_threshold: a.depth_threshold,
+            normal_threshold: a.normal_threshold,
+            jitter_x: jitter.0,
+            jitter_y: jitter.1,
+            _pad0: 0,
         }
     }
 
@@ -313,8 +390,9 @@ impl Renderer {
             }
         }
         let bounces = settings.bounces.max(1);
+        self.ensure_permutations(ctx, settings.seed);
         self.ensure_vpl_slots(ctx, PILOT_PATHS as u64 * bounces as u64)?;
-        let params = self.frame_params(settings, PILOT_PATHS, pilot_base(settings.seed));
+        let params = self.frame_params(settings, PILOT_PATHS, pilot_base(settings.seed), 0);
         ctx.queue
             .write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
         let vb = self.vpl_buffers.as_ref().expect("allocated");
@@ -324,6 +402,7 @@ impl Renderer {
             &vb.slot_buffer,
             &vb.vpls,
             &self.vpl_header,
+            &self.halton_perms.1,
         );
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
         dispatch(
@@ -351,46 +430,28 @@ impl Renderer {
         Ok(paths)
     }
 
-    /// Render one frame and read its image back.
+    /// Render a frame (or `settings.accumulate` frames averaged, each with a fresh VPL set)
+    /// and read its image back; timings are those of the last frame.
     pub fn render(
         &mut self,
         ctx: &GpuContext,
         settings: &RenderSettings,
     ) -> Result<FrameOutput, GpuError> {
         Self::check_size(ctx, settings)?;
-        let paths = self.path_count(ctx, settings)?;
-        let bounces = settings.bounces.max(1);
-        self.ensure_vpl_slots(ctx, paths as u64 * bounces as u64)?;
-        self.ensure_images(&ctx.device, settings.width, settings.height);
-        self.ensure_ranges(ctx, paths as u64 * bounces as u64);
-        let params = self.frame_params(
-            settings,
-            paths,
-            halton_base(settings.seed, settings.frame, paths),
-        );
-        ctx.queue
-            .write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
-
-        let mut encoder = ctx
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("frame"),
-            });
-        self.encode_frame(
-            &ctx.device,
-            &mut encoder,
-            settings.width,
-            settings.height,
-            paths,
-        );
-        self.profiler.resolve(&mut encoder, STAGES.len() as u32);
-        ctx.queue.submit([encoder.finish()]);
-
+        let mut names = vec![];
+        let mut paths = 0;
+        for k in 0..settings.accumulate.max(1) {
+            let frame = RenderSettings {
+                frame: settings.frame + k,
+                ..settings.clone()
+            };
+            (names, paths) = self.submit_frame(ctx, &frame, k)?;
+        }
         let images = self.images.as_ref().expect("allocated");
         let rgba: Vec<[f32; 4]> = ctx.read_buffer(&images.color)?;
         let pixels = settings.width as usize * settings.height as usize;
         let header: Vec<u32> = ctx.read_buffer(&self.vpl_header)?;
-        let timing = self.profiler.read(ctx, &STAGES)?;
+        let timing = self.profiler.read(ctx, &names)?;
         ctx.check()?;
         let (stages, frame_ms) = match timing {
             Some((s, span)) => (s, Some(span)),
@@ -405,6 +466,41 @@ impl Renderer {
         })
     }
 
+    /// Encode and submit one frame; `accumulate_index` frames are already averaged into
+    /// the colour buffer. Returns the stages it ran, in order, and the light paths shot.
+    pub fn submit_frame(
+        &mut self,
+        ctx: &GpuContext,
+        settings: &RenderSettings,
+        accumulate_index: u32,
+    ) -> Result<(Vec<&'static str>, u32), GpuError> {
+        Self::check_size(ctx, settings)?;
+        check_accelerations(settings)?;
+        let paths = self.path_count(ctx, settings)?;
+        self.ensure_permutations(ctx, settings.seed);
+        let bounces = settings.bounces.max(1);
+        self.ensure_vpl_slots(ctx, paths as u64 * bounces as u64)?;
+        self.ensure_images(&ctx.device, settings.width, settings.height);
+        self.ensure_ranges(ctx, paths as u64 * bounces as u64);
+        let params = self.frame_params(
+            settings,
+            paths,
+            halton_base(settings.seed, settings.frame, paths),
+            accumulate_index,
+        );
+        ctx.queue
+            .write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
+        let mut encoder = ctx
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("frame"),
+            });
+        let names = self.encode_frame(&ctx.device, &mut encoder, settings, paths);
+        self.profiler.resolve(&mut encoder, names.len() as u32);
+        ctx.queue.submit([encoder.finish()]);
+        Ok((names, paths))
+    }
+
     /// The VPLs of the last frame (for tests and for drawing them).
     pub fn read_vpls(&self, ctx: &GpuContext) -> Result<Vec<Vpl>, GpuError> {
         let header: Vec<u32> = ctx.read_buffer(&self.vpl_header)?;
@@ -417,14 +513,14 @@ impl Renderer {
     }
 
     /// The passes of one frame, in order (kajiya style: the frame reads top to bottom).
+    /// Returns the names of the stages it encoded, one timestamp pair each.
     pub fn encode_frame(
         &self,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
-        width: u32,
-        height: u32,
+        settings: &RenderSettings,
         paths: u32,
-    ) {
+    ) -> Vec<&'static str> {
         let img = self.images.as_ref().expect("image buffers allocated");
         let vb = self.vpl_buffers.as_ref().expect("vpl buffers allocated");
         let scene = &self.scene.bind_group;
@@ -434,6 +530,15 @@ impl Renderer {
             bind_group: range_group,
             count: *range_count,
         };
+        let a = &settings.accelerations;
+        let iv = a.imperfect_visibility;
+        let full = (settings.width, settings.height);
+        let low = low_resolution(settings);
+        let mut stages: Vec<&'static str> = vec![];
+        let mut stage = |name: &'static str| {
+            stages.push(name);
+            stages.len() as u32 - 1
+        };
 
         let vpl_bind = self.vpl.bind(
             device,
@@ -441,12 +546,14 @@ impl Renderer {
             &vb.slot_buffer,
             &vb.vpls,
             &self.vpl_header,
+            &self.halton_perms.1,
         );
+        let i = stage("vpl shooting");
         dispatch(
             encoder,
             p,
-            0,
-            STAGES[0],
+            i,
+            "vpl shooting",
             &self.vpl.steps(paths),
             scene,
             &vpl_bind,
@@ -466,12 +573,13 @@ impl Renderer {
                 albedo: &img.albedo,
             },
         );
+        let i = stage("direct + specular");
         dispatch(
             encoder,
             p,
-            1,
-            STAGES[1],
-            &self.direct.steps(width, height),
+            i,
+            "direct + specular",
+            &self.direct.steps(full.0, full.1, iv),
             scene,
             &direct_bind,
             Some(&ranges),
@@ -489,36 +597,112 @@ impl Renderer {
                 &img.irradiance,
             ],
         );
+        let i = stage("indirect");
         dispatch(
             encoder,
             p,
-            2,
-            STAGES[2],
-            &self.indirect.steps(width, height),
+            i,
+            "indirect",
+            &self.indirect.steps(low.0, low.1, iv),
             scene,
             &indirect_bind,
             Some(&ranges),
         );
 
+        // The filters, each from the last result to the next buffer.
+        let mut e = &img.irradiance;
+        for (filter, out) in filter_chain(a)
+            .into_iter()
+            .zip([&img.filtered_low, &img.filtered])
+        {
+            let out = match filter {
+                Filter::Discontinuity => out,
+                _ => &img.filtered,
+            };
+            let bind = self
+                .filter
+                .bind(device, &[&self.params, &img.position, &img.normal, e, out]);
+            let i = stage(filter.stage_name());
+            dispatch(
+                encoder,
+                p,
+                i,
+                filter.stage_name(),
+                &self.filter.steps(filter, full, low),
+                scene,
+                &bind,
+                None,
+            );
+            e = out;
+        }
+
         let compose_bind = self.compose.bind(
             device,
-            &[
-                &self.params,
-                &img.direct,
-                &img.albedo,
-                &img.irradiance,
-                &img.color,
-            ],
+            &[&self.params, &img.direct, &img.albedo, e, &img.color],
         );
+        let i = stage("compose");
         dispatch(
             encoder,
             p,
-            3,
-            STAGES[3],
-            &self.compose.steps(width, height),
+            i,
+            "compose",
+            &self.compose.steps(full.0, full.1),
             scene,
             &compose_bind,
             None,
         );
+        stages
     }
 }
+
+/// The resolution of the indirect term: full / downsample, rounded up.
+pub fn low_resolution(settings: &RenderSettings) -> (u32, u32) {
+    let s = settings.accelerations.downsample.max(1);
+    (settings.width.div_ceil(s), settings.height.div_ceil(s))
+}
+
+/// The filters an acceleration set-up runs on the indirect term, in order.
+pub fn filter_chain(a: &Accelerations) -> Vec<Filter> {
+    let interleaved = a.interleave.0 * a.interleave.1 > 1;
+    let downsampled = a.downsample > 1;
+    match a.filter {
+        _ if !interleaved && !downsampled => vec![],
+        FilterMode::Fused => vec![Filter::Fused],
+        FilterMode::TwoPass => {
+            let mut v = vec![];
+            if interleaved {
+                v.push(Filter::Discontinuity);
+            }
+            if downsampled {
+                v.push(Filter::Upsample);
+            }
+            v
+        }
+    }
+}
+
+/// Reject acceleration parameters the passes cannot honour.
+fn check_accelerations(settings: &RenderSettings) -> Result<(), GpuError> {
+    let a = &settings.accelerations;
+    let (n, m) = a.interleave;
+    if n == 0 || m == 0 || n * m > MAX_SUBSETS {
+        return Err(GpuError::Limit(format!(
+            "interleave {n}x{m}: each side must be at least 1 and n x m at most {MAX_SUBSETS}"
+        )));
+    }
+    if a.downsample == 0 || a.downsample > 64 {
+        return Err(GpuError::Limit(format!(
+            "downsample {}: must be between 1 and 64",
+            a.downsample
+        )));
+    }
+    if !(a.upsample_sigma > 0.0 && a.depth_threshold > 0.0 && a.upsample_normal_power >= 0.0) {
+        return Err(GpuError::Limit(
+            "filter parameters: sigma and depth threshold must be positive, the normal power not negative".into(),
+        ));
+    }
+    Ok(())
+}
+
+/// Most VPL subsets of interleaved sampling (the irregular pattern's permutation array).
+pub const MAX_SUBSETS: u32 = 64;

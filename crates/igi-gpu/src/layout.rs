@@ -70,7 +70,7 @@ pub struct Vpl {
     pub _pad1: f32,
 }
 
-/// Parameters of one frame (uniform buffer, 128 bytes).
+/// Parameters of one frame (uniform buffer, 176 bytes).
 /// | offset | field | |
 /// |---|---|---|
 /// | 0 | cam_eye: vec3f | camera position |
@@ -91,7 +91,22 @@ pub struct Vpl {
 /// | 100 | halton_base: u32 | first Halton index of this frame's paths |
 /// | 104 | output: u32 | 0 final, 1 direct, 2 indirect, 3 irradiance |
 /// | 108 | light_power_sum: f32 | sum over lights of (r + g + b) of the power: light choice |
-/// | 112 | _pad: 4 x u32 | |
+/// | 112 | low_width: u32 | width of the indirect term (width / downsample, rounded up) |
+/// | 116 | low_height: u32 | |
+/// | 120 | downsample: u32 | 1 = full resolution |
+/// | 124 | interleave_n: u32 | VPL subsets per tile, across |
+/// | 128 | interleave_m: u32 | and down |
+/// | 132 | pattern: u32 | 0 regular, 1 irregular (a permutation per tile) |
+/// | 136 | seed: u32 | seeds the irregular pattern |
+/// | 140 | accumulate_index: u32 | frames already averaged into the colour buffer |
+/// | 144 | upsample_sigma: f32 | spatial Gaussian of the upsampler, low-res pixels |
+/// | 148 | normal_power: f32 | exponent of the normal weight |
+/// | 152 | upsample_depth: u32 | 1 when depth joins the upsampler's range weight |
+/// | 156 | depth_threshold: f32 | relative depth difference of a discontinuity |
+/// | 160 | normal_threshold: f32 | smallest normal dot product of a continuous neighbour |
+/// | 164 | jitter_x: f32 | primary ray offset within the pixel, in pixels |
+/// | 168 | jitter_y: f32 | |
+/// | 172 | _pad0 | |
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct FrameParams {
@@ -113,5 +128,20 @@ pub struct FrameParams {
     pub halton_base: u32,
     pub output: u32,
     pub light_power_sum: f32,
-    pub _pad: [u32; 4],
+    pub low_width: u32,
+    pub low_height: u32,
+    pub downsample: u32,
+    pub interleave_n: u32,
+    pub interleave_m: u32,
+    pub pattern: u32,
+    pub seed: u32,
+    pub accumulate_index: u32,
+    pub upsample_sigma: f32,
+    pub normal_power: f32,
+    pub upsample_depth: u32,
+    pub depth_threshold: f32,
+    pub normal_threshold: f32,
+    pub jitter_x: f32,
+    pub jitter_y: f32,
+    pub _pad0: u32,
 }

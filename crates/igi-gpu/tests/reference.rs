@@ -48,10 +48,10 @@ fn cornell_box_against_path_traced_references() {
 /// differ. Measured 0.0027 on lavapipe (2026-11-22); bound = measured + 50%.
 const DIRECT_BOUND: f64 = 0.004;
 /// The full image adds the bias of the bounded G (no light from VPLs closer than 0.8 m,
-/// darker corners) and the noise of 180 VPLs. Measured 0.0250 on lavapipe (2026-11-22)
-/// with 191 VPLs (an independent implementation: 0.026-0.030, DESIGN.md); bound =
-/// measured + 40%, room for another adapter's rounding to move VPLs.
-const FULL_BOUND: f64 = 0.035;
+/// darker corners) and the noise of 180 VPLs, which dominates: seeds 0 to 5 measured
+/// 0.0349, 0.0344, 0.0292, 0.0211, 0.0314 (lavapipe and an H200 agree; 2026-11-22; an
+/// independent implementation: 0.026-0.030, DESIGN.md). Bound = the worst seed + 30%.
+const FULL_BOUND: f64 = 0.045;
 
 #[test]
 fn same_seed_same_image() {
@@ -86,4 +86,41 @@ fn same_seed_same_image() {
         },
     );
     assert_ne!(bits(&a.image), bits(&c.image));
+}
+
+/// The paper's conference room (277K non-degenerate triangles) loads, builds and
+/// renders; at a small size on the software adapter to keep CI short.
+#[test]
+fn conference_room_renders() {
+    let Some(shared) = shared() else { return };
+    let Some(ctx) = gpu() else { return };
+    let scene = load_scene(&shared.join("scenes/conference/scene.toml")).expect("scene");
+    let settings = RenderSettings {
+        width: 80,
+        height: 60,
+        vpls: 30,
+        ..RenderSettings::for_scene(&scene)
+    };
+    let frame = render(&ctx, &scene, &settings);
+    let reference = Image::read_exr(
+        &shared
+            .join("references/conference-full.png")
+            .with_extension("exr"),
+    )
+    .unwrap();
+    let (ours, theirs) = (frame.image.mean(), reference.mean());
+    eprintln!(
+        "conference 80x60, {} VPLs: mean {ours:?}, reference (800x600) {theirs:?}",
+        frame.vpl_count
+    );
+    assert!(frame.vpl_count > 0);
+    // A small image of the same view has about the same mean radiance.
+    for c in 0..3 {
+        assert!(
+            (ours[c] - theirs[c]).abs() < 0.15 * theirs[c],
+            "channel {c}: {} vs {}",
+            ours[c],
+            theirs[c]
+        );
+    }
 }

@@ -4,7 +4,7 @@ mod common;
 
 use common::*;
 use igi_core::bvh::Bvh;
-use igi_core::sampling::halton_base;
+use igi_core::sampling::{halton_base, DigitPermutations};
 use igi_core::scene::builtin;
 use igi_core::settings::RenderSettings;
 use igi_core::vpl::shoot_vpls;
@@ -29,6 +29,7 @@ fn gpu_vpls_equal_cpu_twin() {
     let cpu = shoot_vpls(
         &scene,
         &bvh,
+        &DigitPermutations::new(settings.seed),
         frame.path_count,
         settings.bounces,
         settings.mirror_depth,

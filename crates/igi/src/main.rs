@@ -6,7 +6,9 @@ use anyhow::{bail, Context, Result};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use igi_core::bvh::Bvh;
 use igi_core::scene::{builtin, load_scene, Scene};
-use igi_core::settings::{GeometryBound, OutputBuffer, RenderSettings};
+use igi_core::settings::{
+    Accelerations, FilterMode, GeometryBound, InterleavePattern, OutputBuffer, RenderSettings,
+};
 use igi_gpu::{AdapterChoice, GpuContext, Renderer};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -29,6 +31,13 @@ enum Command {
     Render(RenderArgs),
     /// List the GPU adapters wgpu sees and the one igi would pick.
     Info,
+    /// Compare a linear image with a reference (OpenEXR): relative MSE and channel means.
+    Compare {
+        /// The image to measure.
+        image: PathBuf,
+        /// The reference it is measured against.
+        reference: PathBuf,
+    },
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -91,6 +100,135 @@ struct FrameArgs {
     /// Adapter to use: an index or part of a name from `igi info` (default: the best).
     #[arg(long)]
     adapter: Option<String>,
+    #[command(flatten)]
+    accel: AccelArgs,
+}
+
+/// The paper's accelerations (sections 4.1-4.3) and their filters.
+#[derive(Args, Clone)]
+struct AccelArgs {
+    /// A set-up by name, as in the paper's table: canonical, or iv, ds, il (and irregular,
+    /// fused) joined by '+', e.g. iv+ds+il. The options below adjust it.
+    #[arg(long, value_name = "NAME")]
+    setup: Option<String>,
+    /// VPL shadow rays test triangle bounding boxes instead of triangles.
+    #[arg(long)]
+    imperfect_visibility: bool,
+    /// Indirect light at 1/S of the resolution per axis, then joint bilateral upsampling.
+    #[arg(long, value_name = "S")]
+    downsample: Option<u32>,
+    /// Interleaved sampling over NxM VPL subsets, then the discontinuity buffer (e.g. 3x3).
+    #[arg(long, value_name = "NxM", value_parser = parse_interleave)]
+    interleave: Option<(u32, u32)>,
+    /// How subsets are laid out in a tile.
+    #[arg(long, value_enum)]
+    pattern: Option<PatternArg>,
+    /// Discontinuity buffer and upsampling as two passes, or fused in one.
+    #[arg(long, value_enum)]
+    filter: Option<FilterArg>,
+    /// Spatial sigma of the upsampler, in low-resolution pixels.
+    #[arg(long, value_name = "PIXELS")]
+    upsample_sigma: Option<f32>,
+    /// Exponent k of the upsampler's normal weight (N_p . N_q)^k (the paper: 1).
+    #[arg(long, value_name = "K")]
+    normal_power: Option<f32>,
+    /// Leave depth out of the upsampler's range weight (the paper's normal-only weight).
+    #[arg(long)]
+    no_upsample_depth: bool,
+    /// Relative depth difference that counts as a discontinuity.
+    #[arg(long, value_name = "FRACTION")]
+    depth_threshold: Option<f32>,
+    /// Smallest normal dot product of continuous neighbours.
+    #[arg(long, value_name = "COS")]
+    normal_threshold: Option<f32>,
+    /// Average K frames, each with a fresh VPL set (a still camera converges).
+    #[arg(long, value_name = "K", default_value_t = 1)]
+    accumulate: u32,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum PatternArg {
+    Regular,
+    Irregular,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum FilterArg {
+    TwoPass,
+    Fused,
+}
+
+fn parse_interleave(s: &str) -> Result<(u32, u32), String> {
+    let (n, m) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("'{s}' is not NxM (e.g. 3x3)"))?;
+    let parse = |v: &str| v.trim().parse::<u32>().map_err(|_| format!("'{s}' is not NxM (e.g. 3x3)"));
+    let (n, m) = (parse(n)?, parse(m)?);
+    if n == 0 || m == 0 || n * m > 64 {
+        return Err(format!("interleave {n}x{m}: sides of at least 1 and at most 64 subsets"));
+    }
+    Ok((n, m))
+}
+
+impl AccelArgs {
+    fn accelerations(&self) -> Result<Accelerations> {
+        let mut a = match &self.setup {
+            Some(name) => Accelerations::from_setup(name).map_err(anyhow::Error::msg)?,
+            None => Accelerations::default(),
+        };
+        if self.imperfect_visibility {
+            a.imperfect_visibility = true;
+        }
+        if let Some(s) = self.downsample {
+            if s == 0 || s > 64 {
+                bail!("--downsample must be between 1 and 64, got {s}");
+            }
+            a.downsample = s;
+        }
+        if let Some(il) = self.interleave {
+            a.interleave = il;
+        }
+        if let Some(p) = self.pattern {
+            a.pattern = match p {
+                PatternArg::Regular => InterleavePattern::Regular,
+                PatternArg::Irregular => InterleavePattern::Irregular,
+            };
+        }
+        if let Some(f) = self.filter {
+            a.filter = match f {
+                FilterArg::TwoPass => FilterMode::TwoPass,
+                FilterArg::Fused => FilterMode::Fused,
+            };
+        }
+        let positive = |name: &str, v: Option<f32>| -> Result<Option<f32>> {
+            match v {
+                Some(x) if !(x.is_finite() && x > 0.0) => bail!("--{name} must be a positive number, got {x}"),
+                v => Ok(v),
+            }
+        };
+        if let Some(v) = positive("upsample-sigma", self.upsample_sigma)? {
+            a.upsample_sigma = v;
+        }
+        if let Some(v) = self.normal_power {
+            if !(v.is_finite() && v >= 0.0) {
+                bail!("--normal-power must be a number >= 0, got {v}");
+            }
+            a.upsample_normal_power = v;
+        }
+        if self.no_upsample_depth {
+            a.upsample_depth = false;
+        }
+        if let Some(v) = positive("depth-threshold", self.depth_threshold)? {
+            a.depth_threshold = v;
+        }
+        if let Some(v) = self.normal_threshold {
+            if !(-1.0..=1.0).contains(&v) {
+                bail!("--normal-threshold must be between -1 and 1, got {v}");
+            }
+            a.normal_threshold = v;
+        }
+        Ok(a)
+    }
 }
 
 #[derive(Args)]
@@ -153,6 +291,8 @@ fn settings(scene: &Scene, f: &FrameArgs) -> Result<RenderSettings> {
         },
         mirror_depth: f.mirror_depth,
         seed: f.seed,
+        accelerations: f.accel.accelerations()?,
+        accumulate: f.accel.accumulate.max(1),
         ..RenderSettings::default()
     })
 }
@@ -246,6 +386,16 @@ fn info() -> Result<()> {
     Ok(())
 }
 
+fn compare(image: &std::path::Path, reference: &std::path::Path) -> Result<()> {
+    let a = igi_core::image::Image::read_exr(image)?;
+    let b = igi_core::image::Image::read_exr(reference)?;
+    let e = igi_core::image::rel_mse(&a, &b)?;
+    let (ma, mb) = (a.mean(), b.mean());
+    println!("relMSE {e:.5}");
+    println!("mean {:.4} {:.4} {:.4} (reference {:.4} {:.4} {:.4})", ma[0], ma[1], ma[2], mb[0], mb[1], mb[2]);
+    Ok(())
+}
+
 fn main() -> ExitCode {
     env_logger::Builder::from_env(
         env_logger::Env::default()
@@ -257,6 +407,7 @@ fn main() -> ExitCode {
     let result = match &cli.command {
         Command::Render(args) => render(args),
         Command::Info => info(),
+        Command::Compare { image, reference } => compare(image, reference),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,17 +1,21 @@
 //! Binned SAH builder (in the manner of Wald, "On fast construction of SAH-based bounding
 //! volume hierarchies", 2007).
 //!
-//! Every node range is binned into [`SAH_BINS`] bins per axis over its centroid bounds;
-//! the split with the lowest SAH cost among the 3 x (bins - 1) planes is taken. A range
-//! becomes a leaf when it has one triangle, when it has at most [`MAX_LEAF_SIZE`] and the
-//! SAH prefers a leaf, when it reaches [`MAX_DEPTH`], or when its centroids are all equal
-//! and it is small enough (otherwise such a range is split by index at its middle).
+//! A range of more than `SMALL_RANGE` (12) triangles is binned over its centroid bounds,
+//! [`SAH_BINS`] bins per axis (half as many below `FEW_BINS_BELOW` = 256 triangles), and
+//! split at the plane of lowest SAH cost among the 3 x (bins - 1); a smaller range is
+//! split by an exact sweep over its centroids sorted on each axis. A range becomes a leaf
+//! when it has one triangle, when it has at most [`MAX_LEAF_SIZE`] and the SAH prefers a
+//! leaf, or when it reaches the depth cap [`MAX_DEPTH`]. Equal centroids (no plane tells
+//! the triangles apart) are split by index: at the middle for large ranges, by the sweep
+//! for small ones.
 //!
 //! Primitives are 32-byte boxes (`PrimRef`) partitioned in place, with their triangle
 //! indices in a parallel array, so that each level is two sequential passes over memory.
 //! The two subtrees of the top levels are built on separate threads (`std::thread::scope`);
 //! each thread writes its own node list, appended and re-indexed after the join, so nodes
-//! stay in depth-first order (left subtree before right) whatever the thread count.
+//! stay in depth-first order (left subtree before right, children after their parent)
+//! whatever the thread count: the result does not depend on the machine.
 
 use std::time::Instant;
 
@@ -127,9 +131,9 @@ const BIN_MASK: u32 = SAH_BINS as u32 - 1;
 const _: () = assert!(SAH_BINS.is_power_of_two() && SAH_BINS >= 4);
 
 /// Maps doubled centroids to bin indices for one node. Binning and partitioning must
-/// agree exactly, so both go through [`Binner::bin`]/[`Binner::bins`] (the same f32
-/// operations). Bin = round((c - cmin) (BINS - 1) / extent): monotone in c, the minimum
-/// centroid in bin 0 and the maximum in the last, so a split between them always exists.
+/// agree exactly, so both go through [`Binner::bins`] (the same f32 operations).
+/// Bin = round((c - cmin) (bins - 1) / extent): monotone in c, the minimum centroid in
+/// bin 0 and the maximum in the last, so a split between them always exists.
 /// The rounding is done with [`ROUND_MAGIC`] and a mask rather than a float-to-int
 /// cast: the cast's saturation checks cost more than the rest of the binning, and the
 /// mask keeps any index (even of a NaN) inside the bins.
@@ -169,12 +173,6 @@ impl Binner {
     fn bins(&self, c: Vec3A) -> [usize; 3] {
         let x = (c - self.cmin) * self.scale + Vec3A::splat(ROUND_MAGIC);
         [x.x, x.y, x.z].map(|x| (x.to_bits() & BIN_MASK) as usize)
-    }
-
-    #[inline]
-    fn bin(&self, c: Vec3A, axis: usize) -> u32 {
-        let x = (c[axis] - self.cmin[axis]) * self.scale[axis] + ROUND_MAGIC;
-        x.to_bits() & BIN_MASK
     }
 }
 
@@ -604,7 +602,22 @@ fn partition(
     split: &Split,
 ) -> (usize, Aabb, Aabb) {
     let binner = Binner::new(cbounds, bin_count(prims.len()));
-    let left = |c: Vec3A| binner.bin(c, split.axis) < split.bin;
+    // One loop per axis, so that the lane is picked at compile time.
+    match split.axis {
+        0 => partition_on::<0>(prims, ids, &binner, split.bin),
+        1 => partition_on::<1>(prims, ids, &binner, split.bin),
+        _ => partition_on::<2>(prims, ids, &binner, split.bin),
+    }
+}
+
+fn partition_on<const AXIS: usize>(
+    prims: &mut [PrimRef],
+    ids: &mut [u32],
+    binner: &Binner,
+    bin: u32,
+) -> (usize, Aabb, Aabb) {
+    // The same bin as `Binner::bins` gives (same operations on the same lanes).
+    let left = |c: Vec3A| (binner.bins(c)[AXIS] as u32) < bin;
     let mut lc = Aabb::EMPTY;
     let mut rc = Aabb::EMPTY;
     let mut i = 0;
@@ -661,34 +674,37 @@ fn stats(bvh: &Bvh, start: Instant) -> BuildStats {
         index: 0,
         count: 0,
     });
-    let mut cost = SAH_TRAVERSAL_COST as f64;
-    let mut stack = vec![(0u32, 0u32)];
-    while let Some((node, depth)) = stack.pop() {
-        let n = &bvh.nodes[node as usize];
+    // Children always come after their parent (depth-first order), so one pass in index
+    // order sees every node's depth before its children's.
+    let mut depth = vec![0u32; bvh.nodes.len()];
+    let (mut interior_area, mut leaf_area) = (0.0f64, 0.0f64);
+    for (i, n) in bvh.nodes.iter().enumerate() {
         for c in [n.a(), n.b()] {
-            let a = if root_area > 0.0 {
-                (area(&c) / root_area) as f64
-            } else {
-                0.0
-            };
             if c.is_leaf() {
                 if c.min.x > c.max.x {
                     continue; // the empty child
                 }
                 s.leaves += 1;
-                s.max_depth = s.max_depth.max(depth + 1);
+                s.max_depth = s.max_depth.max(depth[i] + 1);
                 s.max_leaf_size = s.max_leaf_size.max(c.count);
                 if c.count as usize > MAX_LEAF_SIZE {
                     s.oversized_leaves += 1;
                 }
-                cost += (SAH_INTERSECT_COST * c.count as f32) as f64 * a;
+                leaf_area += (area(&c) * c.count as f32) as f64;
             } else {
-                cost += SAH_TRAVERSAL_COST as f64 * a;
-                stack.push((c.index, depth + 1));
+                debug_assert!(c.index as usize > i);
+                depth[c.index as usize] = depth[i] + 1;
+                interior_area += area(&c) as f64;
             }
         }
     }
-    s.sah_cost = cost as f32;
+    let cost = if root_area > 0.0 {
+        (SAH_TRAVERSAL_COST as f64 * interior_area + SAH_INTERSECT_COST as f64 * leaf_area)
+            / root_area as f64
+    } else {
+        0.0
+    };
+    s.sah_cost = (SAH_TRAVERSAL_COST as f64 + cost) as f32;
     s.build_ms = start.elapsed().as_secs_f64() * 1e3;
     s
 }

@@ -578,4 +578,3 @@ fn parallel_build_is_deterministic_and_correct() {
         check_ray(&a, &tris, o, d, f32::INFINITY);
     }
 }
-

@@ -23,7 +23,9 @@ pub const NO_HIT: u32 = 0xffff_ffff;
 /// visited for nothing: conservative). Its exit distance (max - o) * 1e30 would be 0 for
 /// an origin on the max plane, where the ray runs inside the closed slab: any exit
 /// distance >= 0 of a parallel axis is therefore replaced by [`FAR_BIG`]. No NaN or
-/// infinity arises from finite data (coordinates up to ~1e7).
+/// infinity arises from finite data (coordinates up to ~1e7); the only infinities are
+/// those of the empty child's box (+inf, -inf), whose distances are +-inf and only make
+/// it miss.
 ///
 /// A component below 1e-30 that is not exactly 0 moves the ray by less than 1e-30 t along
 /// its axis; treating it as 0 can only matter for an origin within 1e-23 of a box plane.
@@ -38,10 +40,11 @@ pub(crate) const FAR_BIG: f32 = 1e38;
 /// gamma(n) = n eps / (1 - n eps), eps = 2^-24 (pbrt-v3/v4 `Bounds3::IntersectP`, Ize
 /// 2013). The slab distances (b - o) * inv carry three roundings (subtraction, reciprocal,
 /// product), so scaling t_far by this factor keeps every box the exact arithmetic would
-/// hit. The literal is 1 + 3 ulp(1), the f32 nearest to 1 + 2 gamma(3) = 1.00000036.
+/// hit. 1 + 3 ulp(1) = 1.00000035762786865234375 is the f32 nearest to
+/// 1 + 2 gamma(3) = 1.0000003576...; traverse.wgsl writes the same value as a literal.
 /// The bound assumes a correctly rounded reciprocal (CPU, lavapipe); WGSL allows 2.5 ulp
 /// for division, which would need 1 + 2 gamma(7) to be strictly covered.
-pub(crate) const BOX_TFAR_SCALE: f32 = 1.000_000_357_627_868_7;
+pub(crate) const BOX_TFAR_SCALE: f32 = 1.0 + 3.0 * f32::EPSILON;
 
 /// Wächter-Binder offset: distance below which coordinates get an absolute offset.
 const OFFSET_ORIGIN: f32 = 1.0 / 32.0;
@@ -435,4 +438,3 @@ pub fn shadow_segment(x: Vec3, nx: Vec3, y: Vec3, ny: Vec3) -> (Vec3, Vec3) {
     let e = offset_ray_origin(y, ny);
     (o, e - o)
 }
-

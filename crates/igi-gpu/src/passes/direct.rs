@@ -1,12 +1,12 @@
 //! Direct + specular at full resolution (paper section 4, second stage), writing the
 //! G-buffer of the primary hits. See `shaders/direct.wgsl`.
 
-use super::{bind, image_groups, pass_layout, pipeline};
+use super::{bind, image_groups, pass_layout, GatherPipelines};
 use crate::scene_buffers::{READ, UNIFORM, WRITE};
 
 pub struct DirectPass {
     pub layout: wgpu::BindGroupLayout,
-    pipeline: wgpu::ComputePipeline,
+    pipelines: GatherPipelines,
 }
 
 /// The buffers the direct pass reads and writes, in binding order after the parameters.
@@ -32,7 +32,11 @@ impl DirectPass {
             &[UNIFORM, READ, READ, WRITE, WRITE, WRITE, WRITE, WRITE],
         );
         DirectPass {
-            pipeline: pipeline(device, "direct", "main", &[scene_layout, &layout, range_layout]),
+            pipelines: GatherPipelines::new(
+                device,
+                "direct",
+                &[scene_layout, &layout, range_layout],
+            ),
             layout,
         }
     }
@@ -60,7 +64,15 @@ impl DirectPass {
         )
     }
 
-    pub fn steps(&self, width: u32, height: u32) -> [(&wgpu::ComputePipeline, [u32; 3]); 1] {
-        [(&self.pipeline, image_groups(width, height))]
+    pub fn steps(
+        &self,
+        width: u32,
+        height: u32,
+        imperfect_visibility: bool,
+    ) -> [(&wgpu::ComputePipeline, [u32; 3]); 1] {
+        [(
+            self.pipelines.get(imperfect_visibility),
+            image_groups(width, height),
+        )]
     }
 }

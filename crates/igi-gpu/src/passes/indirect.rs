@@ -1,12 +1,12 @@
 //! Indirect diffuse light at the primary hits from all VPLs (paper section 4, third
 //! stage), stored as the incident term E without the albedo. See `shaders/indirect.wgsl`.
 
-use super::{bind, image_groups, pass_layout, pipeline};
+use super::{bind, image_groups, pass_layout, GatherPipelines};
 use crate::scene_buffers::{READ, UNIFORM, WRITE};
 
 pub struct IndirectPass {
     pub layout: wgpu::BindGroupLayout,
-    pipeline: wgpu::ComputePipeline,
+    pipelines: GatherPipelines,
 }
 
 impl IndirectPass {
@@ -22,7 +22,11 @@ impl IndirectPass {
             &[UNIFORM, READ, READ, READ, READ, READ, WRITE],
         );
         IndirectPass {
-            pipeline: pipeline(device, "indirect", "main", &[scene_layout, &layout, range_layout]),
+            pipelines: GatherPipelines::new(
+                device,
+                "indirect",
+                &[scene_layout, &layout, range_layout],
+            ),
             layout,
         }
     }
@@ -31,7 +35,15 @@ impl IndirectPass {
         bind(device, "indirect", &self.layout, buffers)
     }
 
-    pub fn steps(&self, width: u32, height: u32) -> [(&wgpu::ComputePipeline, [u32; 3]); 1] {
-        [(&self.pipeline, image_groups(width, height))]
+    pub fn steps(
+        &self,
+        width: u32,
+        height: u32,
+        imperfect_visibility: bool,
+    ) -> [(&wgpu::ComputePipeline, [u32; 3]); 1] {
+        [(
+            self.pipelines.get(imperfect_visibility),
+            image_groups(width, height),
+        )]
     }
 }

@@ -4,6 +4,7 @@
 
 pub mod compose;
 pub mod direct;
+pub mod filter;
 pub mod indirect;
 pub mod vpl;
 
@@ -36,11 +37,54 @@ pub const SOURCES: &[PassSource] = &[
         gathers: true,
     },
     PassSource {
+        name: "filter",
+        wgsl: include_str!("../shaders/filter.wgsl"),
+        gathers: false,
+    },
+    PassSource {
         name: "compose",
         wgsl: include_str!("../shaders/compose.wgsl"),
         gathers: false,
     },
 ];
+
+/// The two builds of a gathering pass: VPL shadow rays against triangles, or against
+/// the triangles' bounding boxes (imperfect visibility, paper section 4.1). One pipeline
+/// each, set by the `IMPERFECT_VISIBILITY` override of gather.wgsl: no branch per ray.
+pub(crate) struct GatherPipelines {
+    exact: wgpu::ComputePipeline,
+    imperfect: wgpu::ComputePipeline,
+}
+
+impl GatherPipelines {
+    pub(crate) fn new(
+        device: &wgpu::Device,
+        name: &str,
+        layouts: &[&wgpu::BindGroupLayout],
+    ) -> GatherPipelines {
+        let build = |iv: f64| {
+            pipeline_with_constants(
+                device,
+                name,
+                "main",
+                layouts,
+                &[("IMPERFECT_VISIBILITY", iv)],
+            )
+        };
+        GatherPipelines {
+            exact: build(0.0),
+            imperfect: build(1.0),
+        }
+    }
+
+    pub(crate) fn get(&self, imperfect_visibility: bool) -> &wgpu::ComputePipeline {
+        if imperfect_visibility {
+            &self.imperfect
+        } else {
+            &self.exact
+        }
+    }
+}
 
 /// Workgroup edge of the image passes (8 x 8 threads).
 pub const TILE: u32 = 8;
@@ -70,6 +114,17 @@ pub(crate) fn pipeline(
     entry: &str,
     layouts: &[&wgpu::BindGroupLayout],
 ) -> wgpu::ComputePipeline {
+    pipeline_with_constants(device, name, entry, layouts, &[])
+}
+
+/// [`pipeline`] with values for the shader's pipeline-overridable constants.
+pub(crate) fn pipeline_with_constants(
+    device: &wgpu::Device,
+    name: &str,
+    entry: &str,
+    layouts: &[&wgpu::BindGroupLayout],
+    constants: &[(&str, f64)],
+) -> wgpu::ComputePipeline {
     let source = SOURCES.iter().find(|s| s.name == name).expect("known pass");
     let desc = wgpu::ShaderModuleDescriptor {
         label: Some(name),
@@ -86,7 +141,10 @@ pub(crate) fn pipeline(
         layout: Some(&layout),
         module: &module,
         entry_point: Some(entry),
-        compilation_options: Default::default(),
+        compilation_options: wgpu::PipelineCompilationOptions {
+            constants,
+            ..Default::default()
+        },
         cache: None,
     })
 }

@@ -2,7 +2,7 @@
 //! VPLs at diffuse hits; a compaction step makes a dense list. See `shaders/vpl.wgsl`.
 
 use super::{bind, pass_layout, pipeline};
-use crate::scene_buffers::{UNIFORM, WRITE};
+use crate::scene_buffers::{READ, UNIFORM, WRITE};
 
 /// Threads per workgroup of the shooting kernel (`SHOOT_GROUP` in the WGSL).
 pub const SHOOT_GROUP: u32 = 64;
@@ -17,8 +17,8 @@ pub struct VplPass {
 
 impl VplPass {
     pub fn new(device: &wgpu::Device, scene_layout: &wgpu::BindGroupLayout) -> VplPass {
-        // params, vpl_slots, vpls, vpl_header
-        let layout = pass_layout(device, "vpl", &[UNIFORM, WRITE, WRITE, WRITE]);
+        // params, vpl_slots, vpls, vpl_header, halton_perms
+        let layout = pass_layout(device, "vpl", &[UNIFORM, WRITE, WRITE, WRITE, READ]);
         VplPass {
             shoot: pipeline(device, "vpl", "shoot", &[scene_layout, &layout]),
             compact: pipeline(device, "vpl", "compact", &[scene_layout, &layout]),
@@ -33,8 +33,14 @@ impl VplPass {
         slots: &wgpu::Buffer,
         vpls: &wgpu::Buffer,
         header: &wgpu::Buffer,
+        halton_perms: &wgpu::Buffer,
     ) -> wgpu::BindGroup {
-        bind(device, "vpl", &self.layout, &[params, slots, vpls, header])
+        bind(
+            device,
+            "vpl",
+            &self.layout,
+            &[params, slots, vpls, header, halton_perms],
+        )
     }
 
     /// The two dispatches of the stage for `paths` light paths: shoot, then compact.

@@ -1,6 +1,7 @@
 // compose.wgsl: the final image (paper section 4, last stage):
 // L = direct_specular + (rho_d(x) / pi) E(x), linear radiance; tone mapping happens only
 // when an image is written. `params.output` picks another buffer for inspection.
+// `irradiance_in` is E at full resolution: the indirect pass's output, or the last filter's.
 
 @group(1) @binding(1) var<storage, read> direct_in: array<vec4<f32>>;
 @group(1) @binding(2) var<storage, read> gbuf_albedo: array<vec4<f32>>;
@@ -22,6 +23,11 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         case 2u: { c = indirect; }
         case 3u: { c = e; }
         default: {}
+    }
+    // Accumulation (--accumulate K): a running mean over frames with fresh VPL sets.
+    let k = f32(params.accumulate_index);
+    if (k > 0.0) {
+        c = (color_out[pixel].xyz * k + c) / (k + 1.0);
     }
     color_out[pixel] = vec4<f32>(c, 1.0);
 }

@@ -1,6 +1,6 @@
 // frame.wgsl: what every pass of the frame shares: the frame parameters (binding 0 of
-// group 1 in every pass), the VPL record, the Halton sequence (GPU twin of
-// igi_core::sampling), sampling maps, hit shading and the bounded geometry term.
+// group 1 in every pass), the VPL record, sampling maps, hit shading and the bounded
+// geometry term.
 
 const PI: f32 = 3.14159265358979;
 const INFINITY: f32 = 3.4e38;
@@ -14,7 +14,11 @@ struct FrameParams {
     total_power: vec3<f32>, light_count: u32,
     path_count: u32, bounces: u32, min_dist: f32, geometry_bound: u32,
     mirror_depth: u32, halton_base: u32, output: u32, light_power_sum: f32,
-    _pad0: u32, _pad1: u32, _pad2: u32, _pad3: u32,
+    // The indirect term's resolution (full / downsample, rounded up) and its filters.
+    low_width: u32, low_height: u32, downsample: u32, interleave_n: u32,
+    interleave_m: u32, pattern: u32, seed: u32, accumulate_index: u32,
+    upsample_sigma: f32, normal_power: f32, upsample_depth: u32, depth_threshold: f32,
+    normal_threshold: f32, jitter_x: f32, jitter_y: f32, _pad0: u32,
 }
 
 // A virtual point light: 64 bytes, see layout.rs.
@@ -34,28 +38,6 @@ struct VplHeader {
 }
 
 @group(1) @binding(0) var<uniform> params: FrameParams;
-
-const PRIMES = array<u32, 64>(2u, 3u, 5u, 7u, 11u, 13u, 17u, 19u, 23u, 29u, 31u, 37u, 41u, 43u, 47u, 53u, 59u, 61u, 67u, 71u, 73u, 79u, 83u, 89u, 97u, 101u, 103u, 107u, 109u, 113u, 127u, 131u, 137u, 139u, 149u, 151u, 157u, 163u, 167u, 173u, 179u, 181u, 191u, 193u, 197u, 199u, 211u, 223u, 227u, 229u, 233u, 239u, 241u, 251u, 257u, 263u, 269u, 271u, 277u, 281u, 283u, 293u, 307u, 311u);
-
-// Radical inverse accumulated in f32 digit by digit, as igi_core::sampling does it.
-fn radical_inverse(base: u32, index: u32) -> f32 {
-    let inv_base = 1.0 / f32(base);
-    var n = index;
-    var weight = inv_base;
-    var value = 0.0;
-    while (n > 0u) {
-        let next = n / base;
-        let digit = n - next * base;
-        value += f32(digit) * weight;
-        weight *= inv_base;
-        n = next;
-    }
-    return min(value, ONE_MINUS_EPSILON);
-}
-
-fn halton(dim: u32, index: u32) -> f32 {
-    return radical_inverse(PRIMES[dim % 64u], index);
-}
 
 fn uniform_sphere(u1: f32, u2: f32) -> vec3<f32> {
     let z = 1.0 - 2.0 * u1;
@@ -123,10 +105,12 @@ fn surface_at(origin: vec3<f32>, dir: vec3<f32>, hit: Hit) -> SurfaceHit {
     return s;
 }
 
-// The primary ray through the centre of pixel (x, y); y = 0 is the top row.
+// The primary ray through pixel (x, y); y = 0 is the top row.
 fn camera_ray_dir(x: u32, y: u32) -> vec3<f32> {
-    let sx = (2.0 * (f32(x) + 0.5) / f32(params.width) - 1.0) * params.tan_half_fov_y * params.aspect;
-    let sy = (1.0 - 2.0 * (f32(y) + 0.5) / f32(params.height)) * params.tan_half_fov_y;
+    // Frame 0 of an accumulation looks through pixel centres; later frames jitter
+    // within the pixel, so that accumulation converges to the pixel's box average.
+    let sx = (2.0 * (f32(x) + 0.5 + params.jitter_x) / f32(params.width) - 1.0) * params.tan_half_fov_y * params.aspect;
+    let sy = (1.0 - 2.0 * (f32(y) + 0.5 + params.jitter_y) / f32(params.height)) * params.tan_half_fov_y;
     return normalize(params.cam_forward + sx * params.cam_right + sy * params.cam_up);
 }
 
@@ -158,4 +142,24 @@ fn direct_irradiance(p: vec3<f32>, ng: vec3<f32>, ns: vec3<f32>) -> vec3<f32> {
         e += light.intensity * cos_x / dist2;
     }
     return e;
+}
+
+// The full-resolution pixel whose G-buffer sample stands for low-resolution pixel
+// (x, y) of the indirect term: the centre of its downsample x downsample block.
+fn representative_pixel(x: u32, y: u32) -> u32 {
+    let half = params.downsample / 2u;
+    let fx = min(x * params.downsample + half, params.width - 1u);
+    let fy = min(y * params.downsample + half, params.height - 1u);
+    return fy * params.width + fx;
+}
+
+// A 32-bit integer hash (igi_core::sampling::hash_u32).
+fn hash_u32(v: u32) -> u32 {
+    var x = v;
+    x ^= x >> 16u;
+    x *= 0x7feb352du;
+    x ^= x >> 15u;
+    x *= 0x846ca68bu;
+    x ^= x >> 16u;
+    return x;
 }

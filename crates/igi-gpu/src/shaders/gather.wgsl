@@ -10,6 +10,10 @@
 // LP_MAX_TGSI_LOOP_ITERATIONS, shared by every loop of the shader), and one VPL costs a
 // whole BVH traversal.
 
+// Imperfect visibility (paper section 4.1): VPL shadow rays test the triangles' bounding
+// boxes instead of the triangles. Set per pipeline (passes::GatherPipelines).
+override IMPERFECT_VISIBILITY: bool = false;
+
 struct GatherRange {
     begin: u32,
     end: u32,
@@ -45,7 +49,7 @@ fn vpl_irradiance(p: vec3<f32>, ng: vec3<f32>, ns: vec3<f32>, first: u32, count:
             continue;
         }
         let end = offset_ray_origin(vpl.position, vpl.normal);
-        if (trace_any(origin, end - origin, 1.0)) {
+        if (trace_shadow(origin, end - origin, 1.0, IMPERFECT_VISIBILITY)) {
             continue;
         }
         e += vpl.flux * vpl.albedo * (g / PI);

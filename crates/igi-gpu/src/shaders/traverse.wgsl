@@ -162,15 +162,45 @@ fn leaf_closest(first: u32, count: u32, r: TraceRay, hit_in: Hit) -> Hit {
     return hit;
 }
 
-fn leaf_any(first: u32, count: u32, r: TraceRay, tmax: f32) -> bool {
+fn leaf_any(first: u32, count: u32, r: TraceRay, tmax: f32, boxes: bool) -> bool {
     for (var slot = first; slot < first + count; slot++) {
         let i = 3u * slot;
-        let h = intersect_triangle(r, tri_verts[i].xyz, tri_verts[i + 1u].xyz, tri_verts[i + 2u].xyz, tmax);
+        let v0 = tri_verts[i].xyz;
+        let v1 = tri_verts[i + 1u].xyz;
+        let v2 = tri_verts[i + 2u].xyz;
+        if (boxes && box_crossed(min(v0, min(v1, v2)), max(v0, max(v1, v2)), r, tmax)) {
+            return true;
+        }
+        let h = intersect_triangle(r, v0, v1, v2, tmax);
         if (h.x > 0.0) {
             return true;
         }
     }
     return false;
+}
+
+// Parametric margin of imperfect visibility, in units of the segment: a box blocks only
+// where the segment enters it after BOX_MARGIN and leaves it before tmax - BOX_MARGIN.
+const BOX_MARGIN: f32 = 1e-4;
+
+// Imperfect visibility (paper section 4.1): whether the segment passes right through a
+// triangle's bounding box. A box that holds (or nearly holds) either end is not counted:
+// every shadow ray starts on a surface, inside the boxes of the triangles around its
+// origin, and ends inside those around the VPL, so counting them would make every
+// oblique (or axis-aligned, whose box is flat) surface shadow itself. Such triangles get
+// the exact test instead, so boxes only ever add occlusion to the exact answer.
+fn box_crossed(bmin: vec3<f32>, bmax: vec3<f32>, r: TraceRay, tmax: f32) -> bool {
+    let t0 = (bmin - r.origin) * r.inv_dir;
+    let t1 = (bmax - r.origin) * r.inv_dir;
+    var tn = select(t0, t1, r.neg);
+    var tf = select(t1, t0, r.neg);
+    // A parallel axis: inside the slab (any t) or never.
+    let inside = r.origin >= bmin & r.origin <= bmax;
+    tn = select(tn, select(vec3<f32>(FAR_BIG), vec3<f32>(-FAR_BIG), inside), r.parallel);
+    tf = select(tf, select(vec3<f32>(-FAR_BIG), vec3<f32>(FAR_BIG), inside), r.parallel);
+    let enter = max(max(tn.x, tn.y), tn.z);
+    let leave = min(min(tf.x, tf.y), tf.z);
+    return enter <= leave && enter > BOX_MARGIN && leave < tmax - BOX_MARGIN;
 }
 
 // Closest hit with 0 < t < tmax; Hit.tri == NO_HIT (and t = tmax) on a miss. `dir` need
@@ -229,7 +259,9 @@ fn trace_closest(origin: vec3<f32>, dir: vec3<f32>, tmax: f32) -> Hit {
 }
 
 // Whether some triangle is hit with 0 < t < tmax (occlusion); returns at the first.
-fn trace_any(origin: vec3<f32>, dir: vec3<f32>, tmax: f32) -> bool {
+// With `boxes` (imperfect visibility), a triangle whose box the segment crosses counts
+// as a hit (see box_crossed).
+fn trace_shadow(origin: vec3<f32>, dir: vec3<f32>, tmax: f32, boxes: bool) -> bool {
     if (all(dir == vec3<f32>(0.0))) {
         return false;
     }
@@ -251,7 +283,7 @@ fn trace_any(origin: vec3<f32>, dir: vec3<f32>, tmax: f32) -> bool {
         var next = NO_HIT;
         if (t0 >= 0.0) {
             if (c0 > 0u) {
-                if (leaf_any(i0, c0, r, tmax)) {
+                if (leaf_any(i0, c0, r, tmax, boxes)) {
                     return true;
                 }
             } else {
@@ -260,7 +292,7 @@ fn trace_any(origin: vec3<f32>, dir: vec3<f32>, tmax: f32) -> bool {
         }
         if (t1 >= 0.0) {
             if (c1 > 0u) {
-                if (leaf_any(i1, c1, r, tmax)) {
+                if (leaf_any(i1, c1, r, tmax, boxes)) {
                     return true;
                 }
             } else if (next == NO_HIT) {
@@ -280,6 +312,11 @@ fn trace_any(origin: vec3<f32>, dir: vec3<f32>, tmax: f32) -> bool {
         node = next;
     }
     return false;
+}
+
+// Exact any-hit query (see trace_shadow).
+fn trace_any(origin: vec3<f32>, dir: vec3<f32>, tmax: f32) -> bool {
+    return trace_shadow(origin, dir, tmax, false);
 }
 
 // Origin for a ray leaving a surface at p, n the unit geometric normal on the side the

@@ -2,13 +2,45 @@
 // particle leaves a point light (chosen in proportion to power), and at every hit on a
 // surface with a diffuse part stores a VPL carrying the particle's flux; it continues by
 // Russian roulette on the mean albedo (diffuse bounce or mirror reflection), up to B
-// stored VPLs. Path i is driven by Halton index halton_base + i: dimension 0 picks the
-// light, 1-2 the emission direction, then 3 per segment (direction u, v; continuation).
+// stored VPLs. Path i is driven by the scrambled Halton sequence at index
+// halton_base + i: dimension 0 picks the light, 1-2 the emission direction, then 3 per
+// segment (direction u, v; continuation).
 // A second entry point compacts the per-path slots into a dense, deterministic VPL list.
 
 @group(1) @binding(1) var<storage, read_write> vpl_slots: array<Vpl>;
 @group(1) @binding(2) var<storage, read_write> vpls: array<Vpl>;
 @group(1) @binding(3) var<storage, read_write> vpl_header: VplHeader;
+// Digit permutations of the scrambled Halton sequence: PRIMES[d] entries for dimension
+// d, concatenated (igi_core::sampling::DigitPermutations).
+@group(1) @binding(4) var<storage, read> halton_perms: array<u32>;
+
+const PRIMES = array<u32, 64>(2u, 3u, 5u, 7u, 11u, 13u, 17u, 19u, 23u, 29u, 31u, 37u, 41u, 43u, 47u, 53u, 59u, 61u, 67u, 71u, 73u, 79u, 83u, 89u, 97u, 101u, 103u, 107u, 109u, 113u, 127u, 131u, 137u, 139u, 149u, 151u, 157u, 163u, 167u, 173u, 179u, 181u, 191u, 193u, 197u, 199u, 211u, 223u, 227u, 229u, 233u, 239u, 241u, 251u, 257u, 263u, 269u, 271u, 277u, 281u, 283u, 293u, 307u, 311u);
+
+// Sum of the primes before each dimension: where its permutation starts.
+const PERMUTATION_OFFSETS = array<u32, 64>(0u, 2u, 5u, 10u, 17u, 28u, 41u, 58u, 77u, 100u, 129u, 160u, 197u, 238u, 281u, 328u, 381u, 440u, 501u, 568u, 639u, 712u, 791u, 874u, 963u, 1060u, 1161u, 1264u, 1371u, 1480u, 1593u, 1720u, 1851u, 1988u, 2127u, 2276u, 2427u, 2584u, 2747u, 2914u, 3087u, 3266u, 3447u, 3638u, 3831u, 4028u, 4227u, 4438u, 4661u, 4888u, 5117u, 5350u, 5589u, 5830u, 6081u, 6338u, 6601u, 6870u, 7141u, 7418u, 7699u, 7982u, 8275u, 8582u);
+
+// Scrambled radical inverse, as igi_core::sampling::scrambled_radical_inverse computes it:
+// every digit of the index (and the zeros past its last one, up to base^k >= 2^32)
+// through the dimension's permutation.
+fn halton(dim_in: u32, index: u32) -> f32 {
+    let dim = dim_in % 64u;
+    let base = PRIMES[dim];
+    let offset = PERMUTATION_OFFSETS[dim];
+    let inv_base = 1.0 / f32(base);
+    var n = index;
+    var weight = inv_base;
+    var value = 0.0;
+    var reach = 1.0;
+    while (reach < 4294967296.0) {
+        let next = n / base;
+        let digit = n - next * base;
+        value += f32(halton_perms[offset + digit]) * weight;
+        weight *= inv_base;
+        reach *= f32(base);
+        n = next;
+    }
+    return min(value, ONE_MINUS_EPSILON);
+}
 
 const SHOOT_GROUP: u32 = 64u;
 
