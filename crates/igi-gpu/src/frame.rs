@@ -92,6 +92,8 @@ pub struct Renderer {
     diagonal: f32,
     /// Paths per frame for (seed, vpls, bounces, mirror depth), from the pilot run.
     path_cache: Option<((u32, u32, u32, u32), u32)>,
+    /// Whether the next frame counts its rays (see [`Renderer::count_rays`]).
+    counting: bool,
 }
 
 fn storage(device: &wgpu::Device, label: &str, size: u64) -> wgpu::Buffer {
@@ -156,6 +158,7 @@ impl Renderer {
             total_power: scene.total_power().to_array(),
             diagonal: scene.diagonal(),
             path_cache: None,
+            counting: false,
         };
         ctx.check()?;
         Ok(renderer)
@@ -365,7 +368,7 @@ impl Renderer {
             normal_threshold: a.normal_threshold,
             jitter_x: jitter.0,
             jitter_y: jitter.1,
-            _pad0: 0,
+            count_rays: 0,
         }
     }
 
@@ -466,6 +469,35 @@ impl Renderer {
         })
     }
 
+    /// GPU times of the last submitted frame's stages `names` (as [`Renderer::submit_frame`]
+    /// returned them) and its span; `None` without timestamp queries. Waits for the frame.
+    pub fn read_timings(
+        &self,
+        ctx: &GpuContext,
+        names: &[&'static str],
+    ) -> Result<Option<(Vec<StageTime>, f64)>, GpuError> {
+        self.profiler.read(ctx, names)
+    }
+
+    /// Rays traced in one frame of `settings`, by kind: [primary, mirror, light shadow,
+    /// VPL shadow, particle]. Renders an extra frame with counting on (one atomic add per
+    /// invocation and kind); the timed frames never count.
+    pub fn count_rays(
+        &mut self,
+        ctx: &GpuContext,
+        settings: &RenderSettings,
+    ) -> Result<[u64; 5], GpuError> {
+        ctx.queue
+            .write_buffer(&self.scene.ray_counters, 0, &[0u8; 32]);
+        self.counting = true;
+        let submitted = self.submit_frame(ctx, settings, 0);
+        self.counting = false;
+        submitted?;
+        let counts: Vec<u32> = ctx.read_buffer(&self.scene.ray_counters)?;
+        ctx.check()?;
+        Ok([0, 1, 2, 3, 4].map(|i| counts[i] as u64))
+    }
+
     /// Encode and submit one frame; `accumulate_index` frames are already averaged into
     /// the colour buffer. Returns the stages it ran, in order, and the light paths shot.
     pub fn submit_frame(
@@ -482,12 +514,13 @@ impl Renderer {
         self.ensure_vpl_slots(ctx, paths as u64 * bounces as u64)?;
         self.ensure_images(&ctx.device, settings.width, settings.height);
         self.ensure_ranges(ctx, paths as u64 * bounces as u64);
-        let params = self.frame_params(
+        let mut params = self.frame_params(
             settings,
             paths,
             halton_base(settings.seed, settings.frame, paths),
             accumulate_index,
         );
+        params.count_rays = self.counting as u32;
         ctx.queue
             .write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
         let mut encoder = ctx

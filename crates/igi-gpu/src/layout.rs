@@ -106,7 +106,7 @@ pub struct Vpl {
 /// | 160 | normal_threshold: f32 | smallest normal dot product of a continuous neighbour |
 /// | 164 | jitter_x: f32 | primary ray offset within the pixel, in pixels |
 /// | 168 | jitter_y: f32 | |
-/// | 172 | _pad0 | |
+/// | 172 | count_rays: u32 | 1 in a frame that counts its rays (scene binding 5) |
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct FrameParams {
@@ -143,5 +143,5 @@ pub struct FrameParams {
     pub normal_threshold: f32,
     pub jitter_x: f32,
     pub jitter_y: f32,
-    pub _pad0: u32,
+    pub count_rays: u32,
 }

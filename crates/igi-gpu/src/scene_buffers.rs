@@ -11,6 +11,8 @@ pub struct SceneBuffers {
     pub layout: wgpu::BindGroupLayout,
     pub bind_group: wgpu::BindGroup,
     pub light_count: u32,
+    /// The ray counters of scene.wgsl (8 x u32).
+    pub ray_counters: wgpu::Buffer,
     /// Bytes held on the GPU by the scene.
     pub bytes: u64,
 }
@@ -65,7 +67,9 @@ impl SceneBuffers {
     pub fn layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
         device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("scene"),
-            entries: &(0..5).map(|b| buffer_entry(b, READ)).collect::<Vec<_>>(),
+            entries: &(0..6)
+                .map(|b| buffer_entry(b, if b == 5 { WRITE } else { READ }))
+                .collect::<Vec<_>>(),
         })
     }
 
@@ -117,9 +121,11 @@ impl SceneBuffers {
             storage_buffer(ctx, "lights", bytemuck::cast_slice(&lights))?,
         ];
         let bytes = buffers.iter().map(|b| b.size()).sum();
+        let ray_counters = storage_buffer(ctx, "ray counters", &[0u8; 32])?;
         let layout = Self::layout(&ctx.device);
         let entries: Vec<wgpu::BindGroupEntry> = buffers
             .iter()
+            .chain([&ray_counters])
             .enumerate()
             .map(|(i, b)| wgpu::BindGroupEntry {
                 binding: i as u32,
@@ -135,6 +141,7 @@ impl SceneBuffers {
             layout,
             bind_group,
             light_count: lights.len() as u32,
+            ray_counters,
             bytes,
         })
     }

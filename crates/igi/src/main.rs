@@ -31,6 +31,9 @@ enum Command {
     Render(RenderArgs),
     /// List the GPU adapters wgpu sees and the one igi would pick.
     Info,
+    /// Measure like the paper: GPU time per stage, fps, rays and image error for every
+    /// scene x set-up x VPL count; writes results.json/.csv/.md, charts and images.
+    Bench(BenchArgs),
     /// Compare a linear image with a reference (OpenEXR): relative MSE and channel means.
     Compare {
         /// The image to measure.
@@ -38,6 +41,46 @@ enum Command {
         /// The reference it is measured against.
         reference: PathBuf,
     },
+}
+
+#[derive(Args)]
+struct BenchArgs {
+    /// Scene files (TOML), or builtin:NAME.
+    #[arg(required = true)]
+    scenes: Vec<String>,
+    /// VPL counts, comma-separated.
+    #[arg(long, value_delimiter = ',', default_value = "30,90,180")]
+    vpls: Vec<u32>,
+    /// Set-ups, comma-separated: canonical, or iv, ds, il, irregular, fused joined by '+'.
+    #[arg(long, value_delimiter = ',', default_value = "canonical,iv,iv+ds,iv+ds+il")]
+    setups: Vec<String>,
+    /// Timed frames per combination.
+    #[arg(long, default_value_t = 10)]
+    frames: u32,
+    /// Untimed frames before them.
+    #[arg(long, default_value_t = 3)]
+    warmup: u32,
+    /// Reference image (EXR) for one scene; otherwise one is looked for beside each scene
+    /// (../../references/NAME-full.exr, or NAME-reference.exr).
+    #[arg(long, value_name = "EXR")]
+    reference: Option<PathBuf>,
+    /// Output directory.
+    #[arg(long, default_value = "bench-out")]
+    out: PathBuf,
+    /// Image width (default: each scene's film).
+    #[arg(long)]
+    width: Option<u32>,
+    /// Image height (default: each scene's film).
+    #[arg(long)]
+    height: Option<u32>,
+    #[arg(long, default_value_t = 0)]
+    seed: u32,
+    /// Adapter: an index or part of a name from `igi info`.
+    #[arg(long)]
+    adapter: Option<String>,
+    /// No progress bar.
+    #[arg(long)]
+    quiet: bool,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -386,6 +429,33 @@ fn info() -> Result<()> {
     Ok(())
 }
 
+fn bench(args: &BenchArgs) -> Result<()> {
+    let opts = igi::bench::run::BenchOptions {
+        scenes: args.scenes.clone(),
+        vpls: args.vpls.clone(),
+        setups: args.setups.clone(),
+        frames: args.frames,
+        warmup: args.warmup,
+        reference: args.reference.clone(),
+        out: args.out.clone(),
+        width: args.width,
+        height: args.height,
+        seed: args.seed,
+        adapter: args.adapter.clone(),
+        quiet: args.quiet,
+        command: std::env::args().collect::<Vec<_>>().join(" "),
+    };
+    let results = igi::bench::run::run(&opts)?;
+    for warning in igi::bench::report::write_all(&results, &args.out)? {
+        eprintln!("warning: {warning}");
+    }
+    if !args.quiet {
+        println!("{}", igi::bench::report::to_markdown(&results));
+    }
+    eprintln!("wrote {}", args.out.join("results.json").display());
+    Ok(())
+}
+
 fn compare(image: &std::path::Path, reference: &std::path::Path) -> Result<()> {
     let a = igi_core::image::Image::read_exr(image)?;
     let b = igi_core::image::Image::read_exr(reference)?;
@@ -407,6 +477,7 @@ fn main() -> ExitCode {
     let result = match &cli.command {
         Command::Render(args) => render(args),
         Command::Info => info(),
+        Command::Bench(args) => bench(args),
         Command::Compare { image, reference } => compare(image, reference),
     };
     match result {

@@ -40,8 +40,10 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         }
         radiance = direct_out[pixel].xyz;
     }
+    var traced = 0u;
     for (var depth = 0u; depth <= params.mirror_depth; depth += 1u) {
         let hit = trace_closest(origin, dir, INFINITY);
+        traced += 1u;
         if (hit.tri == NO_HIT) {
             break;
         }
@@ -73,6 +75,10 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             dir = reflect(dir, s.geometric_normal);
         }
         origin = offset_ray_origin(s.position, s.geometric_normal);
+    }
+    if (first_range) {
+        count_rays(RAY_PRIMARY, 1u);
+        count_rays(RAY_MIRROR, traced - 1u);
     }
     direct_out[pixel] = vec4<f32>(radiance, 1.0);
 }

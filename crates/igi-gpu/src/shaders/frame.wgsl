@@ -6,6 +6,13 @@ const PI: f32 = 3.14159265358979;
 const INFINITY: f32 = 3.4e38;
 const ONE_MINUS_EPSILON: f32 = 0.99999994;
 
+// Kinds of rays, as counted in ray_counters (igi_gpu::frame::RayCounts).
+const RAY_PRIMARY: u32 = 0u;
+const RAY_MIRROR: u32 = 1u;
+const RAY_LIGHT_SHADOW: u32 = 2u;
+const RAY_VPL_SHADOW: u32 = 3u;
+const RAY_PARTICLE: u32 = 4u;
+
 struct FrameParams {
     cam_eye: vec3<f32>, width: u32,
     cam_forward: vec3<f32>, height: u32,
@@ -18,7 +25,7 @@ struct FrameParams {
     low_width: u32, low_height: u32, downsample: u32, interleave_n: u32,
     interleave_m: u32, pattern: u32, seed: u32, accumulate_index: u32,
     upsample_sigma: f32, normal_power: f32, upsample_depth: u32, depth_threshold: f32,
-    normal_threshold: f32, jitter_x: f32, jitter_y: f32, _pad0: u32,
+    normal_threshold: f32, jitter_x: f32, jitter_y: f32, count_rays: u32,
 }
 
 // A virtual point light: 64 bytes, see layout.rs.
@@ -124,10 +131,18 @@ fn bounded_inverse_square(dist2: f32) -> f32 {
     return smoothstep(0.8 * m, 1.2 * m, sqrt(dist2)) / dist2;
 }
 
+// Add n rays of `kind` to the counters when this frame counts rays.
+fn count_rays(kind: u32, n: u32) {
+    if (params.count_rays != 0u && n > 0u) {
+        atomicAdd(&ray_counters[kind], n);
+    }
+}
+
 // Irradiance from the point lights at p (shadow rays from the surface to each light).
 fn direct_irradiance(p: vec3<f32>, ng: vec3<f32>, ns: vec3<f32>) -> vec3<f32> {
     var e = vec3<f32>(0.0);
     let origin = offset_ray_origin(p, ng);
+    var traced = 0u;
     for (var l = 0u; l < params.light_count; l += 1u) {
         let light = lights[l];
         let d = light.position - p;
@@ -136,11 +151,13 @@ fn direct_irradiance(p: vec3<f32>, ng: vec3<f32>, ns: vec3<f32>) -> vec3<f32> {
         if (cos_x <= 0.0 || dot(ng, d) <= 0.0) {
             continue;
         }
+        traced += 1u;
         if (trace_any(origin, light.position - origin, 1.0)) {
             continue;
         }
         e += light.intensity * cos_x / dist2;
     }
+    count_rays(RAY_LIGHT_SHADOW, traced);
     return e;
 }
 

@@ -34,6 +34,7 @@ fn gather_last() -> u32 {
 fn vpl_irradiance(p: vec3<f32>, ng: vec3<f32>, ns: vec3<f32>, first: u32, count: u32, stride: u32) -> vec3<f32> {
     var e = vec3<f32>(0.0);
     let origin = offset_ray_origin(p, ng);
+    var traced = 0u;
     for (var k = first; k < count; k += stride) {
         let vpl = vpls[k];
         let d = vpl.position - p;
@@ -49,10 +50,12 @@ fn vpl_irradiance(p: vec3<f32>, ng: vec3<f32>, ns: vec3<f32>, first: u32, count:
             continue;
         }
         let end = offset_ray_origin(vpl.position, vpl.normal);
+        traced += 1u;
         if (trace_shadow(origin, end - origin, 1.0, IMPERFECT_VISIBILITY)) {
             continue;
         }
         e += vpl.flux * vpl.albedo * (g / PI);
     }
+    count_rays(RAY_VPL_SHADOW, traced);
     return e;
 }

@@ -80,8 +80,10 @@ fn shoot(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups)
     var dim = 3u;
     // Mirror reflections store nothing, so the walk is bounded separately.
     let max_segments = params.bounces + params.mirror_depth;
+    var traced = 0u;
     for (var segment = 0u; segment < max_segments; segment += 1u) {
         let hit = trace_closest(origin, dir, INFINITY);
+        traced += 1u;
         if (hit.tri == NO_HIT) {
             break;
         }
@@ -124,6 +126,7 @@ fn shoot(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups)
         origin = offset_ray_origin(s.position, s.geometric_normal);
         dim += 3u;
     }
+    count_rays(RAY_PARTICLE, traced);
     // Slots this path did not fill are marked empty for compaction.
     for (var k = stored; k < params.bounces; k += 1u) {
         vpl_slots[first_slot + k].valid = 0u;
