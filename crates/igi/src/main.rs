@@ -52,7 +52,11 @@ struct BenchArgs {
     #[arg(long, value_delimiter = ',', default_value = "30,90,180")]
     vpls: Vec<u32>,
     /// Set-ups, comma-separated: canonical, or iv, ds, il, irregular, fused joined by '+'.
-    #[arg(long, value_delimiter = ',', default_value = "canonical,iv,iv+ds,iv+ds+il")]
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "canonical,iv,iv+ds,iv+ds+il"
+    )]
     setups: Vec<String>,
     /// Timed frames per combination.
     #[arg(long, default_value_t = 10)]
@@ -205,10 +209,16 @@ fn parse_interleave(s: &str) -> Result<(u32, u32), String> {
     let (n, m) = s
         .split_once(['x', 'X'])
         .ok_or_else(|| format!("'{s}' is not NxM (e.g. 3x3)"))?;
-    let parse = |v: &str| v.trim().parse::<u32>().map_err(|_| format!("'{s}' is not NxM (e.g. 3x3)"));
+    let parse = |v: &str| {
+        v.trim()
+            .parse::<u32>()
+            .map_err(|_| format!("'{s}' is not NxM (e.g. 3x3)"))
+    };
     let (n, m) = (parse(n)?, parse(m)?);
     if n == 0 || m == 0 || n * m > 64 {
-        return Err(format!("interleave {n}x{m}: sides of at least 1 and at most 64 subsets"));
+        return Err(format!(
+            "interleave {n}x{m}: sides of at least 1 and at most 64 subsets"
+        ));
     }
     Ok((n, m))
 }
@@ -245,7 +255,9 @@ impl AccelArgs {
         }
         let positive = |name: &str, v: Option<f32>| -> Result<Option<f32>> {
             match v {
-                Some(x) if !(x.is_finite() && x > 0.0) => bail!("--{name} must be a positive number, got {x}"),
+                Some(x) if !(x.is_finite() && x > 0.0) => {
+                    bail!("--{name} must be a positive number, got {x}")
+                }
                 v => Ok(v),
             }
         };
@@ -462,7 +474,10 @@ fn compare(image: &std::path::Path, reference: &std::path::Path) -> Result<()> {
     let e = igi_core::image::rel_mse(&a, &b)?;
     let (ma, mb) = (a.mean(), b.mean());
     println!("relMSE {e:.5}");
-    println!("mean {:.4} {:.4} {:.4} (reference {:.4} {:.4} {:.4})", ma[0], ma[1], ma[2], mb[0], mb[1], mb[2]);
+    println!(
+        "mean {:.4} {:.4} {:.4} (reference {:.4} {:.4} {:.4})",
+        ma[0], ma[1], ma[2], mb[0], mb[1], mb[2]
+    );
     Ok(())
 }
 

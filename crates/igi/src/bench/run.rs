@@ -42,12 +42,17 @@ pub fn find_reference(scene_path: &Path) -> Option<PathBuf> {
     let dir = scene_path.parent()?;
     let stem = scene_path.file_stem()?.to_string_lossy().to_string();
     let name = if stem == "scene" {
-        dir.canonicalize().ok()?.file_name()?.to_string_lossy().to_string()
+        dir.canonicalize()
+            .ok()?
+            .file_name()?
+            .to_string_lossy()
+            .to_string()
     } else {
         stem
     };
     [
-        dir.join("../../references").join(format!("{name}-full.exr")),
+        dir.join("../../references")
+            .join(format!("{name}-full.exr")),
         dir.join(format!("{name}-reference.exr")),
     ]
     .into_iter()
@@ -61,9 +66,16 @@ pub fn scene_name(arg: &str) -> String {
         return name.to_string();
     }
     let p = Path::new(arg);
-    let stem = p.file_stem().map(|s| s.to_string_lossy().to_string()).unwrap_or_default();
+    let stem = p
+        .file_stem()
+        .map(|s| s.to_string_lossy().to_string())
+        .unwrap_or_default();
     if stem == "scene" {
-        if let Some(dir) = p.canonicalize().ok().and_then(|c| c.parent().map(Path::to_path_buf)) {
+        if let Some(dir) = p
+            .canonicalize()
+            .ok()
+            .and_then(|c| c.parent().map(Path::to_path_buf))
+        {
             if let Some(n) = dir.file_name() {
                 return n.to_string_lossy().to_string();
             }
@@ -75,7 +87,10 @@ pub fn scene_name(arg: &str) -> String {
 fn load(arg: &str) -> Result<Scene> {
     match arg.strip_prefix("builtin:") {
         Some(name) => builtin::builtin_scene(name).with_context(|| {
-            format!("no built-in scene '{name}' (there is: {})", builtin::BUILTIN_NAMES.join(", "))
+            format!(
+                "no built-in scene '{name}' (there is: {})",
+                builtin::BUILTIN_NAMES.join(", ")
+            )
         }),
         None => Ok(load_scene(Path::new(arg))?),
     }
@@ -140,12 +155,20 @@ pub fn run(opts: &BenchOptions) -> Result<BenchResults> {
     let setups: Vec<(String, Accelerations)> = opts
         .setups
         .iter()
-        .map(|s| Accelerations::from_setup(s).map(|a| (s.clone(), a)).map_err(anyhow::Error::msg))
+        .map(|s| {
+            Accelerations::from_setup(s)
+                .map(|a| (s.clone(), a))
+                .map_err(anyhow::Error::msg)
+        })
         .collect::<Result<_>>()?;
-    std::fs::create_dir_all(&opts.out).with_context(|| format!("cannot create '{}'", opts.out.display()))?;
+    std::fs::create_dir_all(&opts.out)
+        .with_context(|| format!("cannot create '{}'", opts.out.display()))?;
     let ctx = GpuContext::new(&AdapterChoice::from_option(opts.adapter.as_deref()))?;
     if !ctx.timestamps {
-        bail!("adapter '{}' has no timestamp queries: igi bench needs them", ctx.info.name);
+        bail!(
+            "adapter '{}' has no timestamp queries: igi bench needs them",
+            ctx.info.name
+        );
     }
     let combos = (opts.scenes.len() * setups.len() * opts.vpls.len()) as u64;
     let bar = if opts.quiet {
@@ -209,7 +232,11 @@ pub fn run(opts: &BenchOptions) -> Result<BenchResults> {
                         let time = stats(&mut v);
                         StageStats {
                             name: name.to_string(),
-                            share: if frame.median_ms > 0.0 { time.median_ms / frame.median_ms } else { 0.0 },
+                            share: if frame.median_ms > 0.0 {
+                                time.median_ms / frame.median_ms
+                            } else {
+                                0.0
+                            },
                             time,
                         }
                     })
@@ -223,12 +250,18 @@ pub fn run(opts: &BenchOptions) -> Result<BenchResults> {
                     vpl_shadow: counts[3],
                     particle: counts[4],
                 };
-                let stem = format!("{}-{}-{vpls}", super::report::file_stem(&name), setup.replace('+', "_"));
+                let stem = format!(
+                    "{}-{}-{vpls}",
+                    super::report::file_stem(&name),
+                    setup.replace('+', "_")
+                );
                 let (exr, png) = (format!("{stem}.exr"), format!("{stem}.png"));
                 output.image.write_exr(&opts.out.join(&exr))?;
                 output.image.write_png(&opts.out.join(&png), 1.0)?;
                 let error = match (&reference, &reference_path) {
-                    (Some(r), Some(p)) if r.width == output.image.width && r.height == output.image.height => {
+                    (Some(r), Some(p))
+                        if r.width == output.image.width && r.height == output.image.height =>
+                    {
                         Some(ImageErrors {
                             reference: p.display().to_string(),
                             rel_mse: rel_mse(&output.image, r)?,
@@ -236,14 +269,16 @@ pub fn run(opts: &BenchOptions) -> Result<BenchResults> {
                         })
                     }
                     (Some(r), Some(p)) => {
-                        bar.suspend(|| eprintln!(
-                            "note: reference {} is {}x{}, the image {}x{}: no error measured",
-                            p.display(),
-                            r.width,
-                            r.height,
-                            output.image.width,
-                            output.image.height
-                        ));
+                        bar.suspend(|| {
+                            eprintln!(
+                                "note: reference {} is {}x{}, the image {}x{}: no error measured",
+                                p.display(),
+                                r.width,
+                                r.height,
+                                output.image.width,
+                                output.image.height
+                            )
+                        });
                         None
                     }
                     _ => None,
@@ -261,7 +296,11 @@ pub fn run(opts: &BenchOptions) -> Result<BenchResults> {
                     vpl_count: output.vpl_count,
                     light_paths: output.path_count,
                     fps: if median_s > 0.0 { 1.0 / median_s } else { 0.0 },
-                    rays_per_s: if median_s > 0.0 { rays.total() as f64 / median_s } else { 0.0 },
+                    rays_per_s: if median_s > 0.0 {
+                        rays.total() as f64 / median_s
+                    } else {
+                        0.0
+                    },
                     rays,
                     frame,
                     stages,
@@ -280,7 +319,9 @@ pub fn run(opts: &BenchOptions) -> Result<BenchResults> {
         meta: BenchMeta {
             adapter: ctx.info.name.clone(),
             backend: format!("{:?}", ctx.info.backend),
-            driver: format!("{} {}", ctx.info.driver, ctx.info.driver_info).trim().to_string(),
+            driver: format!("{} {}", ctx.info.driver, ctx.info.driver_info)
+                .trim()
+                .to_string(),
             git_commit: env!("IGI_GIT_COMMIT").to_string(),
             date: utc_now(),
             command: opts.command.clone(),
