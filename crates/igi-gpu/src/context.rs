@@ -240,7 +240,7 @@ impl GpuContext {
 
     /// Largest storage buffer one binding may hold on this device, in bytes.
     pub fn max_storage_binding(&self) -> u64 {
-        self.device.limits().max_storage_buffer_binding_size as u64
+        self.device.limits().max_storage_buffer_binding_size
     }
 
     /// Read a storage buffer back to the CPU (through a staging copy).

@@ -360,7 +360,7 @@ impl Renderer {
                 InterleavePattern::Irregular => 1,
             },
             seed: settings.seed,
-            accumulate_index: accumulate_index,
+            accumulate_index,
             upsample_sigma: a.upsample_sigma,
             normal_power: a.upsample_normal_power,
             upsample_depth: a.upsample_depth as u32,

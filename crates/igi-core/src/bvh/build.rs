@@ -268,9 +268,11 @@ where
             };
         }
     });
+    eprint!("prims {:.1} ", start.elapsed().as_secs_f64()*1e3);
     let mut ids: Vec<u32> = (0..count as u32).collect();
     let (bounds, cbounds) = range_bounds(&prims);
 
+    eprint!("bounds {:.1} ", start.elapsed().as_secs_f64()*1e3);
     let mut nodes = Vec::with_capacity(count);
     let par_levels = threads().next_power_of_two().trailing_zeros() + 1;
     let root = build_node(
@@ -297,6 +299,7 @@ where
         ));
     }
     drop(prims);
+    eprint!("tree {:.1} ", start.elapsed().as_secs_f64()*1e3);
 
     let mut tri_verts = vec![[0.0f32; 4]; 3 * count];
     par_chunks(&mut tri_verts, 3, |base, chunk| {
@@ -308,6 +311,7 @@ where
         }
     });
 
+    eprint!("verts {:.1} ", start.elapsed().as_secs_f64()*1e3);
     let mut bvh = Bvh {
         nodes,
         tri_verts,
@@ -347,6 +351,7 @@ fn build_node(task: Task<'_>, out: &mut Vec<BvhNode>, limits: &Limits) -> BvhChi
             && leaf_cost <= SAH_TRAVERSAL_COST * area + SAH_INTERSECT_COST * split_cost
     };
 
+    let t0 = Instant::now();
     let (k, lb, lc, rb, rc) = if n <= SMALL_RANGE {
         let sweep = SmallSweep::new(task.prims);
         if worth_a_leaf(sweep.cost) {
@@ -373,6 +378,7 @@ fn build_node(task: Task<'_>, out: &mut Vec<BvhNode>, limits: &Limits) -> BvhChi
         }
     };
 
+    if task.depth == 0 { eprint!("root split {:.1} ", t0.elapsed().as_secs_f64()*1e3); }
     let slot = out.len();
     out.push(BvhNode::zeroed());
     let depth = task.depth + 1;
@@ -706,5 +712,6 @@ fn stats(bvh: &Bvh, start: Instant) -> BuildStats {
     };
     s.sah_cost = (SAH_TRAVERSAL_COST as f64 + cost) as f32;
     s.build_ms = start.elapsed().as_secs_f64() * 1e3;
+    eprintln!("stats {:.1}", s.build_ms);
     s
 }
