@@ -8,6 +8,7 @@
 pub mod bvh;
 pub mod image;
 pub mod metrics;
+pub mod rays;
 pub mod sampling;
 pub mod scene;
 pub mod settings;

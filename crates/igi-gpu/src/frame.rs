@@ -534,6 +534,87 @@ impl Renderer {
         Ok((names, paths))
     }
 
+    /// The VPL shadow rays of a real frame of `settings` (canonical: every pixel against
+    /// every VPL, exactly the segments the indirect pass traces), at most `count`, taken
+    /// from pixels spread over the whole image (every k-th pixel in scanline order, so
+    /// that each pixel keeps its rays to all VPLs together, as in the frame).
+    pub fn frame_shadow_rays(
+        &mut self,
+        ctx: &GpuContext,
+        settings: &RenderSettings,
+        count: usize,
+    ) -> Result<Vec<igi_core::rays::RayRecord>, GpuError> {
+        use glam::Vec3;
+        use igi_core::bvh::offset_ray_origin;
+        let canonical = RenderSettings {
+            accelerations: Accelerations::default(),
+            accumulate: 1,
+            ..settings.clone()
+        };
+        self.render(ctx, &canonical)?;
+        let img = self.images.as_ref().expect("rendered");
+        let positions: Vec<[f32; 4]> = ctx.read_buffer(&img.position)?;
+        let normals: Vec<[f32; 4]> = ctx.read_buffer(&img.normal)?;
+        let geometric: Vec<[f32; 4]> = ctx.read_buffer(&img.geometric)?;
+        let vpls = self.read_vpls(ctx)?;
+        let m = settings
+            .min_dist
+            .unwrap_or(igi_core::settings::DEFAULT_MIN_DIST_FRACTION * self.diagonal);
+        let pixels = (settings.width * settings.height) as usize;
+        let rays_of = |p: usize, out: &mut Vec<igi_core::rays::RayRecord>| {
+            if positions[p][3] <= 0.0 {
+                return;
+            }
+            let x = Vec3::from_slice(&positions[p][..3]);
+            let ns = Vec3::from_slice(&normals[p][..3]);
+            let ng = Vec3::from_slice(&geometric[p][..3]);
+            let origin = offset_ray_origin(x, ng);
+            for v in &vpls {
+                let y = Vec3::from(v.position);
+                let ny = Vec3::from(v.normal);
+                let d = y - x;
+                let dist2 = d.length_squared();
+                let dist = dist2.sqrt();
+                let (cos_x, cos_y) = (ns.dot(d) / dist, -ny.dot(d) / dist);
+                if cos_x <= 0.0 || cos_y <= 0.0 || ng.dot(d) <= 0.0 {
+                    continue;
+                }
+                let bound = match settings.geometry_bound {
+                    GeometryBound::Clamp => 1.0,
+                    GeometryBound::Smoothstep => {
+                        let t = ((dist - 0.8 * m) / (0.4 * m)).clamp(0.0, 1.0);
+                        t * t * (3.0 - 2.0 * t)
+                    }
+                };
+                if bound <= 0.0 {
+                    continue;
+                }
+                out.push(igi_core::rays::RayRecord::segment(
+                    origin,
+                    offset_ray_origin(y, ny),
+                ));
+            }
+        };
+        // Count first, then take every k-th pixel.
+        let mut all = 0usize;
+        let mut scratch = vec![];
+        for p in 0..pixels {
+            scratch.clear();
+            rays_of(p, &mut scratch);
+            all += scratch.len();
+        }
+        let stride = all.div_ceil(count.max(1)).max(1);
+        let mut out = Vec::with_capacity(count.min(all));
+        for p in (0..pixels).step_by(stride) {
+            rays_of(p, &mut out);
+            if out.len() >= count {
+                break;
+            }
+        }
+        out.truncate(count);
+        Ok(out)
+    }
+
     /// The VPLs of the last frame (for tests and for drawing them).
     pub fn read_vpls(&self, ctx: &GpuContext) -> Result<Vec<Vpl>, GpuError> {
         let header: Vec<u32> = ctx.read_buffer(&self.vpl_header)?;

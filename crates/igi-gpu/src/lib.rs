@@ -10,6 +10,7 @@ pub mod frame;
 pub mod layout;
 pub mod passes;
 pub mod profiler;
+pub mod raybench;
 pub mod scene_buffers;
 pub mod shader;
 

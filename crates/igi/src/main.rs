@@ -33,7 +33,7 @@ enum Command {
     Info,
     /// Measure like the paper: GPU time per stage, fps, rays and image error for every
     /// scene x set-up x VPL count; writes results.json/.csv/.md, charts and images.
-    Bench(BenchArgs),
+    Bench(BenchCommand),
     /// Compare a linear image with a reference (OpenEXR): relative MSE and channel means.
     Compare {
         /// The image to measure.
@@ -41,6 +41,75 @@ enum Command {
         /// The reference it is measured against.
         reference: PathBuf,
     },
+}
+
+#[derive(Args)]
+#[command(args_conflicts_with_subcommands = true, subcommand_negates_reqs = true)]
+struct BenchCommand {
+    #[command(subcommand)]
+    sub: Option<BenchSub>,
+    #[command(flatten)]
+    args: BenchArgs,
+}
+
+#[derive(Subcommand)]
+enum BenchSub {
+    /// The ray-tracing layer alone: rays/s of the any-hit and closest-hit queries on a ray
+    /// set (random segments and rays, or the VPL shadow rays of a real frame), in the ray
+    /// file format of docs/BENCHMARKS.md so another tracer can trace the very same rays.
+    Rays(RaysArgs),
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum RayKindArg {
+    Shadow,
+    Closest,
+    Both,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum RaySetArg {
+    /// Segments between (shadow) and rays from (closest) area-uniform random surface points.
+    Random,
+    /// The VPL shadow rays of a canonical frame (shadow only).
+    Frame,
+}
+
+#[derive(Args)]
+struct RaysArgs {
+    /// The scene file (TOML), or builtin:NAME.
+    scene: String,
+    /// Number of rays.
+    #[arg(long, default_value_t = 1 << 24)]
+    count: usize,
+    /// Which query to time.
+    #[arg(long, value_enum, default_value = "both")]
+    kind: RayKindArg,
+    /// Which rays.
+    #[arg(long, value_enum, default_value = "random")]
+    set: RaySetArg,
+    /// Save the generated rays (with a single --kind).
+    #[arg(long, value_name = "FILE", conflicts_with = "load")]
+    save: Option<PathBuf>,
+    /// Trace rays from a file instead of generating them.
+    #[arg(long, value_name = "FILE")]
+    load: Option<PathBuf>,
+    /// Timed runs after one warm-up; the median is reported.
+    #[arg(long, default_value_t = 10)]
+    runs: u32,
+    /// VPLs of the frame set.
+    #[arg(long, default_value_t = 180)]
+    vpls: u32,
+    /// Image size of the frame set (default: the scene's film).
+    #[arg(long)]
+    width: Option<u32>,
+    #[arg(long)]
+    height: Option<u32>,
+    #[arg(long, default_value_t = 0)]
+    seed: u32,
+    /// Adapter: an index or part of a name from `igi info`.
+    #[arg(long)]
+    adapter: Option<String>,
 }
 
 #[derive(Args)]
@@ -468,6 +537,93 @@ fn bench(args: &BenchArgs) -> Result<()> {
     Ok(())
 }
 
+fn bench_rays(args: &RaysArgs) -> Result<()> {
+    use igi_core::rays::{random_rays, random_segments, read_rays, write_rays};
+    use igi_gpu::raybench::{RayBench, RayQuery};
+    if args.count == 0 {
+        bail!("--count must be at least 1");
+    }
+    if args.save.is_some() && args.kind == RayKindArg::Both {
+        bail!("--save writes one ray set: give --kind shadow or --kind closest");
+    }
+    if args.set == RaySetArg::Frame && args.kind != RayKindArg::Shadow && args.load.is_none() {
+        bail!("the frame set holds shadow rays: use --kind shadow");
+    }
+    let scene = match args.scene.strip_prefix("builtin:") {
+        Some(name) => {
+            builtin::builtin_scene(name).with_context(|| format!("no built-in scene '{name}'"))?
+        }
+        None => load_scene(std::path::Path::new(&args.scene))?,
+    };
+    let t = Instant::now();
+    let bvh = Bvh::build(&scene.triangles);
+    let bvh_ms = t.elapsed().as_secs_f64() * 1e3;
+    let ctx = GpuContext::new(&AdapterChoice::from_option(args.adapter.as_deref()))?;
+    if !ctx.timestamps {
+        bail!(
+            "adapter '{}' has no timestamp queries: igi bench rays needs them",
+            ctx.info.name
+        );
+    }
+    eprintln!(
+        "scene {}: {} triangles, BVH built in {bvh_ms:.1} ms; adapter: {}",
+        scene.source,
+        scene.triangles.len(),
+        ctx.describe()
+    );
+    let queries: Vec<RayQuery> = match args.kind {
+        RayKindArg::Shadow => vec![RayQuery::AnyHit],
+        RayKindArg::Closest => vec![RayQuery::ClosestHit],
+        RayKindArg::Both => vec![RayQuery::AnyHit, RayQuery::ClosestHit],
+    };
+    let bench = RayBench::new(&ctx, &scene, &bvh)?;
+    for query in queries {
+        let rays = match (&args.load, args.set, query) {
+            (Some(path), _, _) => read_rays(path)?,
+            (None, RaySetArg::Random, RayQuery::AnyHit) => {
+                random_segments(&scene, args.count, args.seed)
+            }
+            (None, RaySetArg::Random, RayQuery::ClosestHit) => {
+                random_rays(&scene, args.count, args.seed)
+            }
+            (None, RaySetArg::Frame, _) => {
+                let settings = RenderSettings {
+                    width: args.width.unwrap_or(scene.film.width),
+                    height: args.height.unwrap_or(scene.film.height),
+                    vpls: args.vpls,
+                    seed: args.seed,
+                    ..RenderSettings::for_scene(&scene)
+                };
+                let mut renderer = Renderer::new(&ctx, &scene, &bvh)?;
+                renderer.frame_shadow_rays(&ctx, &settings, args.count)?
+            }
+        };
+        if let Some(path) = &args.save {
+            write_rays(path, &rays)?;
+            eprintln!("wrote {} rays to {}", rays.len(), path.display());
+        }
+        let timing = bench.trace(&ctx, &rays, query, args.runs.max(1))?;
+        let mut runs = timing.runs_ms.clone();
+        runs.sort_by(f64::total_cmp);
+        let median = runs[runs.len() / 2];
+        let name = match query {
+            RayQuery::AnyHit => "shadow (any hit)",
+            RayQuery::ClosestHit => "closest hit",
+        };
+        println!(
+            "{name}: {} rays, {:.1}% {}, median {median:.3} ms over {} runs (min {:.3}, max {:.3}): {:.3} G rays/s",
+            rays.len(),
+            100.0 * timing.hits as f64 / rays.len() as f64,
+            if query == RayQuery::AnyHit { "occluded" } else { "hit" },
+            runs.len(),
+            runs[0],
+            runs[runs.len() - 1],
+            rays.len() as f64 / median * 1e-6
+        );
+    }
+    Ok(())
+}
+
 fn compare(image: &std::path::Path, reference: &std::path::Path) -> Result<()> {
     let a = igi_core::image::Image::read_exr(image)?;
     let b = igi_core::image::Image::read_exr(reference)?;
@@ -492,7 +648,10 @@ fn main() -> ExitCode {
     let result = match &cli.command {
         Command::Render(args) => render(args),
         Command::Info => info(),
-        Command::Bench(args) => bench(args),
+        Command::Bench(cmd) => match &cmd.sub {
+            Some(BenchSub::Rays(r)) => bench_rays(r),
+            None => bench(&cmd.args),
+        },
         Command::Compare { image, reference } => compare(image, reference),
     };
     match result {

@@ -198,3 +198,128 @@ fn no_adapter_says_what_to_install() {
         .unwrap();
     assert_one_error_line(&out, &["mesa-vulkan-drivers"]);
 }
+
+fn skipped_for_no_adapter(out: &Output) -> bool {
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    if stderr.contains("no GPU adapter") {
+        eprintln!("skipped: {stderr}");
+        return true;
+    }
+    false
+}
+
+#[test]
+fn bench_runs_tiny_and_its_json_parses() {
+    let d = temp_dir("bench");
+    let out = igi(&[
+        "bench",
+        "builtin:cornell-box",
+        "--width",
+        "32",
+        "--height",
+        "32",
+        "--vpls",
+        "30",
+        "--setups",
+        "iv+ds+il",
+        "--frames",
+        "1",
+        "--warmup",
+        "0",
+        "--quiet",
+        "--out",
+        d.to_str().unwrap(),
+    ]);
+    if skipped_for_no_adapter(&out) {
+        return;
+    }
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = std::fs::read_to_string(d.join("results.json")).unwrap();
+    // Every field present: the typed parse fails on a missing one.
+    let results: igi::bench::model::BenchResults = serde_json::from_str(&text).unwrap();
+    assert_eq!(results.runs.len(), 1);
+    let run = &results.runs[0];
+    assert_eq!(
+        (run.width, run.height, run.setup.as_str()),
+        (32, 32, "iv+ds+il")
+    );
+    assert!(run.frame.median_ms > 0.0 && run.fps > 0.0);
+    let names: Vec<&str> = run.stages.iter().map(|s| s.name.as_str()).collect();
+    assert_eq!(
+        names,
+        [
+            "vpl shooting",
+            "direct + specular",
+            "indirect",
+            "discontinuity",
+            "upsample",
+            "compose"
+        ]
+    );
+    assert_eq!(run.rays.primary, 32 * 32);
+    assert!(run.rays.vpl_shadow > 0 && run.rays.particle > 0);
+    assert!(d.join("results.csv").exists() && d.join("results.md").exists());
+    assert!(d.join(&run.image_exr).exists());
+}
+
+#[test]
+fn bench_rays_saves_and_loads_the_same_rays() {
+    let d = temp_dir("rays");
+    let file = d.join("rays.bin");
+    let first = igi(&[
+        "bench",
+        "rays",
+        "builtin:cornell-box",
+        "--count",
+        "4096",
+        "--kind",
+        "shadow",
+        "--runs",
+        "1",
+        "--save",
+        file.to_str().unwrap(),
+    ]);
+    if skipped_for_no_adapter(&first) {
+        return;
+    }
+    assert!(
+        first.status.success(),
+        "{}",
+        String::from_utf8_lossy(&first.stderr)
+    );
+    assert_eq!(std::fs::metadata(&file).unwrap().len(), 4096 * 32);
+    let second = igi(&[
+        "bench",
+        "rays",
+        "builtin:cornell-box",
+        "--kind",
+        "shadow",
+        "--runs",
+        "1",
+        "--load",
+        file.to_str().unwrap(),
+    ]);
+    assert!(second.status.success());
+    // The same rays give the same occluded fraction.
+    let fraction = |o: &Output| {
+        let s = String::from_utf8_lossy(&o.stdout).to_string();
+        s.split(", ").nth(1).unwrap_or_default().to_string()
+    };
+    assert_eq!(fraction(&first), fraction(&second));
+    // A file that is not a ray file is one clear error.
+    std::fs::write(&file, b"not rays").unwrap();
+    let bad = igi(&[
+        "bench",
+        "rays",
+        "builtin:cornell-box",
+        "--kind",
+        "shadow",
+        "--load",
+        file.to_str().unwrap(),
+    ]);
+    assert_one_error_line(&bad, &["rays.bin", "multiple of 32"]);
+}

@@ -19,6 +19,7 @@
 
 use std::time::Instant;
 
+use bytemuck::Zeroable;
 use glam::{BVec3A, Vec3, Vec3A};
 
 use super::{
@@ -203,24 +204,63 @@ fn threads() -> usize {
 }
 
 /// Runs `f(chunk_start, chunk)` over `data` split into one chunk per thread, each chunk a
-/// multiple of `align` long.
-fn par_chunks<T: Send, F>(data: &mut [T], align: usize, f: F)
+/// multiple of `align` long; returns the results in chunk order.
+fn par_chunks<T: Send, R: Send, F>(data: &mut [T], align: usize, f: F) -> Vec<R>
 where
-    F: Fn(usize, &mut [T]) + Sync,
+    F: Fn(usize, &mut [T]) -> R + Sync,
 {
     let n = data.len();
     let t = threads();
     if t == 1 || n < 4096 {
-        f(0, data);
-        return;
+        return vec![f(0, data)];
     }
     let chunk = n.div_ceil(t).next_multiple_of(align);
     std::thread::scope(|s| {
-        for (k, c) in data.chunks_mut(chunk).enumerate() {
-            let f = &f;
-            s.spawn(move || f(k * chunk, c));
-        }
-    });
+        let handles: Vec<_> = data
+            .chunks_mut(chunk)
+            .enumerate()
+            .map(|(k, c)| {
+                let f = &f;
+                s.spawn(move || f(k * chunk, c))
+            })
+            .collect();
+        handles
+            .into_iter()
+            .map(|h| h.join().expect("BVH build thread panicked"))
+            .collect()
+    })
+}
+
+/// Counts and areas gathered while building, for [`BuildStats`].
+#[derive(Default)]
+struct Tally {
+    leaves: usize,
+    max_depth: u32,
+    max_leaf_size: u32,
+    oversized_leaves: usize,
+    /// Sum of the half areas of all interior nodes but the root.
+    interior_area: f64,
+    /// Sum of half area x triangle count over leaves.
+    leaf_area: f64,
+}
+
+impl Tally {
+    fn leaf(&mut self, depth: u32, count: usize, half_area: f32) {
+        self.leaves += 1;
+        self.max_depth = self.max_depth.max(depth);
+        self.max_leaf_size = self.max_leaf_size.max(count as u32);
+        self.oversized_leaves += usize::from(count > MAX_LEAF_SIZE);
+        self.leaf_area += (half_area * count as f32) as f64;
+    }
+
+    fn merge(&mut self, o: Tally) {
+        self.leaves += o.leaves;
+        self.max_depth = self.max_depth.max(o.max_depth);
+        self.max_leaf_size = self.max_leaf_size.max(o.max_leaf_size);
+        self.oversized_leaves += o.oversized_leaves;
+        self.interior_area += o.interior_area;
+        self.leaf_area += o.leaf_area;
+    }
 }
 
 fn build_impl<F>(count: usize, tri: F, max_depth: u32) -> Bvh
@@ -234,14 +274,12 @@ where
         "too many triangles for one BVH: {count}"
     );
     if count == 0 {
-        let mut bvh = Bvh {
+        return Bvh {
             nodes: vec![BvhNode::new(BvhChild::EMPTY, BvhChild::EMPTY)],
             tri_verts: vec![],
             tri_order: vec![],
-            build_stats: BuildStats::default(),
+            build_stats: stats(0, 1, Tally::default(), 0.0, start),
         };
-        bvh.build_stats = stats(&bvh, start);
-        return bvh;
     }
 
     let mut prims = vec![
@@ -251,7 +289,7 @@ where
         };
         count
     ];
-    par_chunks(&mut prims, 1, |base, chunk| {
+    let chunk_bounds = par_chunks(&mut prims, 1, |base, chunk| {
         for (k, p) in chunk.iter_mut().enumerate() {
             let [a, b, c] = tri(base + k).map(Vec3A::from);
             let (lo, hi) = (a.min(b).min(c), a.max(b).max(c));
@@ -267,13 +305,17 @@ where
                 }
             };
         }
+        range_bounds(chunk)
     });
-    eprint!("prims {:.1} ", start.elapsed().as_secs_f64()*1e3);
+    let (mut bounds, mut cbounds) = (Aabb::EMPTY, Aabb::EMPTY);
+    for (b, c) in chunk_bounds {
+        bounds.grow(&b);
+        cbounds.grow(&c);
+    }
     let mut ids: Vec<u32> = (0..count as u32).collect();
-    let (bounds, cbounds) = range_bounds(&prims);
 
-    eprint!("bounds {:.1} ", start.elapsed().as_secs_f64()*1e3);
     let mut nodes = Vec::with_capacity(count);
+    let mut tally = Tally::default();
     let par_levels = threads().next_power_of_two().trailing_zeros() + 1;
     let root = build_node(
         Task {
@@ -285,21 +327,23 @@ where
             depth: 0,
         },
         &mut nodes,
+        &mut tally,
         &Limits {
             max_depth,
             par_levels,
         },
     );
     if root.count > 0 {
-        // A root that is a leaf still needs an interior node 0 to hold its box.
+        // A root that is a leaf still needs an interior node 0 to hold its box; the leaf
+        // is its child, at depth 1.
         debug_assert!(nodes.is_empty());
+        tally.max_depth = 1;
         nodes.push(BvhNode::new(
             bounds.child(root.index, root.count),
             BvhChild::EMPTY,
         ));
     }
     drop(prims);
-    eprint!("tree {:.1} ", start.elapsed().as_secs_f64()*1e3);
 
     let mut tri_verts = vec![[0.0f32; 4]; 3 * count];
     par_chunks(&mut tri_verts, 3, |base, chunk| {
@@ -311,15 +355,13 @@ where
         }
     });
 
-    eprint!("verts {:.1} ", start.elapsed().as_secs_f64()*1e3);
-    let mut bvh = Bvh {
+    let build_stats = stats(count, nodes.len(), tally, bounds.half_area(), start);
+    Bvh {
         nodes,
         tri_verts,
         tri_order: ids,
-        build_stats: BuildStats::default(),
-    };
-    bvh.build_stats = stats(&bvh, start);
-    bvh
+        build_stats,
+    }
 }
 
 /// Box and (doubled) centroid box of a range.
@@ -337,32 +379,41 @@ fn range_bounds(prims: &[PrimRef]) -> (Aabb, Aabb) {
 /// Builds the subtree of `task`; pushes its interior nodes to `out` (depth first, this
 /// node first) and returns the reference to it as a child: an interior node (count 0,
 /// index into `out`) or a leaf (count > 0, index = first BVH slot).
-fn build_node(task: Task<'_>, out: &mut Vec<BvhNode>, limits: &Limits) -> BvhChild {
+fn build_node(
+    task: Task<'_>,
+    out: &mut Vec<BvhNode>,
+    tally: &mut Tally,
+    limits: &Limits,
+) -> BvhChild {
     let n = task.prims.len();
-    let leaf = task.bounds.child(task.first, n as u32);
+    let area = task.bounds.half_area();
+    let leaf = |tally: &mut Tally| {
+        tally.leaf(task.depth, n, area);
+        task.bounds.child(task.first, n as u32)
+    };
     if n == 1 || task.depth >= limits.max_depth {
-        return leaf;
+        return leaf(tally);
     }
 
-    let area = task.bounds.half_area();
     let leaf_cost = SAH_INTERSECT_COST * n as f32 * area;
     let worth_a_leaf = |split_cost: f32| {
         n <= MAX_LEAF_SIZE
             && leaf_cost <= SAH_TRAVERSAL_COST * area + SAH_INTERSECT_COST * split_cost
     };
 
-    let t0 = Instant::now();
     let (k, lb, lc, rb, rc) = if n <= SMALL_RANGE {
         let sweep = SmallSweep::new(task.prims);
         if worth_a_leaf(sweep.cost) {
-            return leaf;
+            return leaf(tally);
         }
         sweep.apply(task.prims, task.ids)
     } else {
-        match find_split(task.prims, &task.cbounds) {
+        // The root's binning is the only large pass no thread shares: spread it.
+        let parallel = task.depth == 0 && n >= 4 * PARALLEL_MIN_PRIMS;
+        match find_split(task.prims, &task.cbounds, parallel) {
             Some(split) => {
                 if worth_a_leaf(split.cost) {
-                    return leaf;
+                    return leaf(tally);
                 }
                 let (k, lc, rc) = partition(task.prims, task.ids, &task.cbounds, &split);
                 debug_assert!(k > 0 && k < n);
@@ -378,7 +429,9 @@ fn build_node(task: Task<'_>, out: &mut Vec<BvhNode>, limits: &Limits) -> BvhChi
         }
     };
 
-    if task.depth == 0 { eprint!("root split {:.1} ", t0.elapsed().as_secs_f64()*1e3); }
+    if task.depth > 0 {
+        tally.interior_area += area as f64;
+    }
     let slot = out.len();
     out.push(BvhNode::zeroed());
     let depth = task.depth + 1;
@@ -403,11 +456,13 @@ fn build_node(task: Task<'_>, out: &mut Vec<BvhNode>, limits: &Limits) -> BvhChi
 
     let (a, b) = if task.depth < limits.par_levels && n >= PARALLEL_MIN_PRIMS {
         let mut right_nodes = Vec::with_capacity(n - k);
+        let mut right_tally = Tally::default();
         let (a, b) = std::thread::scope(|s| {
-            let handle = s.spawn(|| build_node(right, &mut right_nodes, limits));
-            let a = build_node(left, out, limits);
+            let handle = s.spawn(|| build_node(right, &mut right_nodes, &mut right_tally, limits));
+            let a = build_node(left, out, tally, limits);
             (a, handle.join().expect("BVH build thread panicked"))
         });
+        tally.merge(right_tally);
         // The right subtree numbered its nodes from 0: move them behind the left one.
         let offset = out.len() as u32;
         out.extend(right_nodes.into_iter().map(|mut node| {
@@ -425,8 +480,8 @@ fn build_node(task: Task<'_>, out: &mut Vec<BvhNode>, limits: &Limits) -> BvhChi
         }
         (a, b)
     } else {
-        let a = build_node(left, out, limits);
-        let b = build_node(right, out, limits);
+        let a = build_node(left, out, tally, limits);
+        let b = build_node(right, out, tally, limits);
         (a, b)
     };
     out[slot] = BvhNode::new(a, b);
@@ -437,8 +492,6 @@ fn build_node(task: Task<'_>, out: &mut Vec<BvhNode>, limits: &Limits) -> BvhChi
         count: 0,
     }
 }
-
-use bytemuck::Zeroable;
 
 /// Exact SAH sweep of a small range (2..=SMALL_RANGE primitives): for each axis the
 /// primitives sorted by centroid, every split between neighbours in that order.
@@ -530,11 +583,10 @@ impl SmallSweep {
     }
 }
 
-/// Best SAH split of a range over [`SAH_BINS`] bins per axis, or None when all
-/// centroids are equal.
-fn find_split(prims: &[PrimRef], cbounds: &Aabb) -> Option<Split> {
-    let nb = bin_count(prims.len());
-    let binner = Binner::new(cbounds, nb);
+/// Bounds and primitive counts of the bins, per axis.
+type Bins = ([[Aabb; SAH_BINS]; 3], [[u32; SAH_BINS]; 3]);
+
+fn bin_range(prims: &[PrimRef], binner: &Binner) -> Bins {
     let mut bins = [[Aabb::EMPTY; SAH_BINS]; 3];
     let mut counts = [[0u32; SAH_BINS]; 3];
     for p in prims {
@@ -547,7 +599,40 @@ fn find_split(prims: &[PrimRef], cbounds: &Aabb) -> Option<Split> {
             counts[axis][k] += 1;
         }
     }
+    (bins, counts)
+}
 
+/// Best SAH split of a range over [`SAH_BINS`] bins per axis, or None when all
+/// centroids are equal.
+fn find_split(prims: &[PrimRef], cbounds: &Aabb, parallel: bool) -> Option<Split> {
+    let nb = bin_count(prims.len());
+    let binner = Binner::new(cbounds, nb);
+    let (bins, counts) = if parallel && threads() > 1 {
+        let chunk = prims.len().div_ceil(threads());
+        let parts: Vec<Bins> = std::thread::scope(|s| {
+            let handles: Vec<_> = prims
+                .chunks(chunk)
+                .map(|c| s.spawn(|| bin_range(c, &binner)))
+                .collect();
+            handles
+                .into_iter()
+                .map(|h| h.join().expect("BVH build thread panicked"))
+                .collect()
+        });
+        let mut parts = parts.into_iter();
+        let (mut bins, mut counts) = parts.next().expect("at least one chunk");
+        for (b, c) in parts {
+            for axis in 0..3 {
+                for k in 0..nb {
+                    bins[axis][k].grow(&b[axis][k]);
+                    counts[axis][k] += c[axis][k];
+                }
+            }
+        }
+        (bins, counts)
+    } else {
+        bin_range(prims, &binner)
+    };
     let mut best: Option<(usize, u32, f32)> = None;
     for axis in 0..3 {
         if binner.scale[axis] == 0.0 {
@@ -663,12 +748,28 @@ fn partition_on<const AXIS: usize>(
     }
 }
 
-fn stats(bvh: &Bvh, start: Instant) -> BuildStats {
-    let mut s = BuildStats {
-        triangles: bvh.tri_order.len(),
-        nodes: bvh.nodes.len(),
-        ..BuildStats::default()
+fn stats(triangles: usize, nodes: usize, t: Tally, root_area: f32, start: Instant) -> BuildStats {
+    let cost = if root_area > 0.0 {
+        (SAH_TRAVERSAL_COST as f64 * t.interior_area + SAH_INTERSECT_COST as f64 * t.leaf_area)
+            / root_area as f64
+    } else {
+        0.0
     };
+    BuildStats {
+        build_ms: start.elapsed().as_secs_f64() * 1e3,
+        triangles,
+        nodes,
+        leaves: t.leaves,
+        max_depth: t.max_depth,
+        max_leaf_size: t.max_leaf_size,
+        oversized_leaves: t.oversized_leaves,
+        sah_cost: (SAH_TRAVERSAL_COST as f64 + cost) as f32,
+    }
+}
+
+/// The same statistics by walking the finished tree (tests check both agree).
+#[cfg(test)]
+pub(super) fn stats_by_walk(bvh: &Bvh) -> BuildStats {
     let area = |c: &BvhChild| {
         let e = (c.max - c.min).max(Vec3::ZERO);
         e.x * e.y + e.y * e.z + e.z * e.x
@@ -680,38 +781,31 @@ fn stats(bvh: &Bvh, start: Instant) -> BuildStats {
         index: 0,
         count: 0,
     });
-    // Children always come after their parent (depth-first order), so one pass in index
-    // order sees every node's depth before its children's.
+    let mut t = Tally::default();
+    // Children come after their parent (depth-first order): one pass in index order sees
+    // every node's depth before its children's.
     let mut depth = vec![0u32; bvh.nodes.len()];
-    let (mut interior_area, mut leaf_area) = (0.0f64, 0.0f64);
     for (i, n) in bvh.nodes.iter().enumerate() {
         for c in [n.a(), n.b()] {
             if c.is_leaf() {
                 if c.min.x > c.max.x {
                     continue; // the empty child
                 }
-                s.leaves += 1;
-                s.max_depth = s.max_depth.max(depth[i] + 1);
-                s.max_leaf_size = s.max_leaf_size.max(c.count);
-                if c.count as usize > MAX_LEAF_SIZE {
-                    s.oversized_leaves += 1;
-                }
-                leaf_area += (area(&c) * c.count as f32) as f64;
+                t.leaf(depth[i] + 1, c.count as usize, area(&c));
             } else {
-                debug_assert!(c.index as usize > i);
+                assert!(c.index as usize > i, "child {} before parent {i}", c.index);
                 depth[c.index as usize] = depth[i] + 1;
-                interior_area += area(&c) as f64;
+                t.interior_area += area(&c) as f64;
             }
         }
     }
-    let cost = if root_area > 0.0 {
-        (SAH_TRAVERSAL_COST as f64 * interior_area + SAH_INTERSECT_COST as f64 * leaf_area)
-            / root_area as f64
-    } else {
-        0.0
-    };
-    s.sah_cost = (SAH_TRAVERSAL_COST as f64 + cost) as f32;
-    s.build_ms = start.elapsed().as_secs_f64() * 1e3;
-    eprintln!("stats {:.1}", s.build_ms);
+    let mut s = stats(
+        bvh.tri_order.len(),
+        bvh.nodes.len(),
+        t,
+        root_area,
+        Instant::now(),
+    );
+    s.build_ms = bvh.build_stats.build_ms;
     s
 }

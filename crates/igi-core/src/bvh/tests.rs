@@ -88,6 +88,17 @@ fn check_structure(bvh: &Bvh, tris: &[[Vec3; 3]]) {
     assert!(leaf_slots.iter().all(|&s| s), "a slot in no leaf");
     assert!(node_seen.iter().all(|&s| s), "an unreachable node");
     assert!(bvh.build_stats.max_depth <= MAX_DEPTH);
+    // The statistics gathered while building are those of the finished tree.
+    let mut walked = super::build::stats_by_walk(bvh);
+    let built = &bvh.build_stats;
+    assert!(
+        (walked.sah_cost - built.sah_cost).abs() <= 1e-5 * built.sah_cost,
+        "SAH cost {} built, {} walked",
+        built.sah_cost,
+        walked.sah_cost
+    );
+    walked.sah_cost = built.sah_cost;
+    assert_eq!(&walked, built);
 }
 
 /// The BVH's closest hit must be the brute force's (same triangle, or another at the
@@ -144,6 +155,7 @@ fn node_layout_matches_wgsl() {
 fn empty_bvh_misses_everything() {
     let bvh = Bvh::build(&[]);
     assert_eq!(bvh.nodes.len(), 1);
+    assert_eq!((bvh.build_stats.leaves, bvh.build_stats.max_depth), (0, 0));
     assert!(bvh.tri_verts.is_empty() && bvh.tri_order.is_empty());
     let mut r = rng(1);
     for _ in 0..100 {
@@ -564,9 +576,10 @@ fn segments_between_facing_planes_are_unoccluded() {
 
 #[test]
 fn parallel_build_is_deterministic_and_correct() {
-    // Large enough for the threaded top levels.
+    // Large enough for the threaded top levels and the threaded binning of the root
+    // (the result must not depend on the number of threads).
     let mut r = rng(13);
-    let tris = random_triangles(&mut r, 60_000, 100.0, 1.5);
+    let tris = random_triangles(&mut r, 70_000, 100.0, 1.5);
     let a = Bvh::build_from_vertices(&tris);
     let b = Bvh::build_from_vertices(&tris);
     assert_eq!(a.nodes, b.nodes);

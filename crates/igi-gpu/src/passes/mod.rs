@@ -42,6 +42,11 @@ pub const SOURCES: &[PassSource] = &[
         gathers: false,
     },
     PassSource {
+        name: "rays",
+        wgsl: include_str!("../shaders/rays.wgsl"),
+        gathers: false,
+    },
+    PassSource {
         name: "compose",
         wgsl: include_str!("../shaders/compose.wgsl"),
         gathers: false,

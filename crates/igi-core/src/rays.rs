@@ -1,0 +1,232 @@
+//! Ray sets for measuring the ray-tracing layer alone (`igi bench rays`), and the ray file
+//! format another ray tracer can read to trace the very same rays.
+//!
+//! # Ray file format
+//! A flat array of rays, no header, little-endian IEEE-754 `f32`, 32 bytes a ray:
+//!
+//! | offset | field | |
+//! |---|---|---|
+//! | 0 | origin x, y, z | already offset off the surface it leaves |
+//! | 12 | tmin | always 0 |
+//! | 16 | direction x, y, z | unit length |
+//! | 28 | tmax | segment length for shadow rays; 3.4e38 ("infinity") for closest-hit rays |
+//!
+//! Surface points are offset with the method of Wächter and Binder (Ray Tracing Gems,
+//! ch. 6, [`crate::bvh::offset_ray_origin`]): a shadow segment runs from x moved off its
+//! surface towards y, to y moved off its surface towards x, so neither end surface can
+//! occlude it.
+
+use crate::bvh::offset_ray_origin;
+use crate::sampling::hash_u32;
+use crate::scene::Scene;
+use bytemuck::{Pod, Zeroable};
+use glam::Vec3;
+use std::path::Path;
+
+/// One ray as stored in a ray file (32 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct RayRecord {
+    pub origin: [f32; 3],
+    pub tmin: f32,
+    pub dir: [f32; 3],
+    pub tmax: f32,
+}
+
+/// tmax of a ray without an end.
+pub const RAY_INFINITY: f32 = 3.4e38;
+
+impl RayRecord {
+    /// The shadow segment from a to b (both already offset).
+    pub fn segment(a: Vec3, b: Vec3) -> RayRecord {
+        let d = b - a;
+        let len = d.length();
+        RayRecord {
+            origin: a.to_array(),
+            tmin: 0.0,
+            dir: (d / len.max(f32::MIN_POSITIVE)).to_array(),
+            tmax: len,
+        }
+    }
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum RayFileError {
+    #[error("cannot read ray file '{0}': {1}")]
+    Read(String, String),
+    #[error(
+        "ray file '{0}' has {1} bytes, not a multiple of 32 (origin, tmin, direction, tmax as f32)"
+    )]
+    Size(String, u64),
+    #[error("ray file '{0}' holds no rays")]
+    Empty(String),
+    #[error("ray {1} of '{0}' is not finite or has a zero direction")]
+    Bad(String, usize),
+    #[error("cannot write ray file '{0}': {1}")]
+    Write(String, String),
+}
+
+/// Write rays in the documented format (through a temporary file and a rename).
+pub fn write_rays(path: &Path, rays: &[RayRecord]) -> Result<(), RayFileError> {
+    let bytes: &[u8] = bytemuck::cast_slice(rays);
+    crate::image::write_atomically(path, |tmp| {
+        std::fs::write(tmp, bytes).map_err(|e| e.to_string())
+    })
+    .map_err(|e| RayFileError::Write(path.display().to_string(), e.to_string()))
+}
+
+/// Read and check a ray file.
+pub fn read_rays(path: &Path) -> Result<Vec<RayRecord>, RayFileError> {
+    let name = path.display().to_string();
+    let bytes = std::fs::read(path).map_err(|e| RayFileError::Read(name.clone(), e.to_string()))?;
+    if bytes.len() % 32 != 0 {
+        return Err(RayFileError::Size(name, bytes.len() as u64));
+    }
+    if bytes.is_empty() {
+        return Err(RayFileError::Empty(name));
+    }
+    let rays: Vec<RayRecord> = bytes
+        .chunks_exact(32)
+        .map(|c| {
+            let f: Vec<f32> = c
+                .chunks_exact(4)
+                .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+                .collect();
+            RayRecord {
+                origin: [f[0], f[1], f[2]],
+                tmin: f[3],
+                dir: [f[4], f[5], f[6]],
+                tmax: f[7],
+            }
+        })
+        .collect();
+    for (i, r) in rays.iter().enumerate() {
+        let ok = r
+            .origin
+            .iter()
+            .chain(&r.dir)
+            .chain([&r.tmin, &r.tmax])
+            .all(|v| v.is_finite())
+            && Vec3::from(r.dir) != Vec3::ZERO;
+        if !ok {
+            return Err(RayFileError::Bad(name, i));
+        }
+    }
+    Ok(rays)
+}
+
+/// A small deterministic generator (hash of a counter) for ray sets.
+struct Uniform {
+    state: u32,
+}
+
+impl Uniform {
+    fn next(&mut self) -> f32 {
+        self.state = hash_u32(self.state.wrapping_add(0x9e37_79b9));
+        (self.state >> 8) as f32 / (1u32 << 24) as f32
+    }
+}
+
+/// Area-uniform random points on the scene's surfaces: (point, unit geometric normal).
+fn surface_points(scene: &Scene, count: usize, seed: u32) -> Vec<(Vec3, Vec3)> {
+    let mut cdf = Vec::with_capacity(scene.triangles.len());
+    let mut total = 0.0f64;
+    for t in &scene.triangles {
+        total += t.area() as f64;
+        cdf.push(total);
+    }
+    let mut rng = Uniform {
+        state: hash_u32(seed ^ 0x5eed),
+    };
+    (0..count)
+        .map(|_| {
+            let target = rng.next() as f64 * total;
+            let i = cdf.partition_point(|&c| c < target).min(cdf.len() - 1);
+            let t = &scene.triangles[i];
+            let (mut u, mut v) = (rng.next(), rng.next());
+            if u + v > 1.0 {
+                (u, v) = (1.0 - u, 1.0 - v);
+            }
+            let p = t.v[0] + u * (t.v[1] - t.v[0]) + v * (t.v[2] - t.v[0]);
+            (p, t.cross().normalize())
+        })
+        .collect()
+}
+
+/// Shadow segments between pairs of area-uniform random surface points, each end moved
+/// off its surface on the side facing the other end.
+pub fn random_segments(scene: &Scene, count: usize, seed: u32) -> Vec<RayRecord> {
+    let a = surface_points(scene, count, seed);
+    let b = surface_points(scene, count, seed.wrapping_add(1));
+    a.iter()
+        .zip(&b)
+        .map(|(&(pa, na), &(pb, nb))| {
+            let d = pb - pa;
+            let na = if na.dot(d) < 0.0 { -na } else { na };
+            let nb = if nb.dot(d) > 0.0 { -nb } else { nb };
+            RayRecord::segment(offset_ray_origin(pa, na), offset_ray_origin(pb, nb))
+        })
+        .collect()
+}
+
+/// Closest-hit rays from area-uniform random surface points in uniform random directions
+/// (origin moved off the surface on the side the ray leaves to).
+pub fn random_rays(scene: &Scene, count: usize, seed: u32) -> Vec<RayRecord> {
+    let points = surface_points(scene, count, seed);
+    let mut rng = Uniform {
+        state: hash_u32(seed ^ 0xd1ec),
+    };
+    points
+        .iter()
+        .map(|&(p, n)| {
+            let d = crate::sampling::uniform_sphere(rng.next(), rng.next());
+            let n = if n.dot(d) < 0.0 { -n } else { n };
+            RayRecord {
+                origin: offset_ray_origin(p, n).to_array(),
+                tmin: 0.0,
+                dir: d.to_array(),
+                tmax: RAY_INFINITY,
+            }
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ray_file_round_trips_and_rejects_junk() {
+        let dir = std::env::temp_dir().join(format!("igi-rays-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let scene = crate::scene::builtin::builtin_scene("cornell-box").unwrap();
+        let rays = random_segments(&scene, 100, 1);
+        let path = dir.join("r.bin");
+        write_rays(&path, &rays).unwrap();
+        assert_eq!(std::fs::metadata(&path).unwrap().len(), 3200);
+        assert_eq!(read_rays(&path).unwrap(), rays);
+        // Little-endian f32 at the documented offsets.
+        let bytes = std::fs::read(&path).unwrap();
+        let tmax = f32::from_le_bytes(bytes[28..32].try_into().unwrap());
+        assert_eq!(tmax, rays[0].tmax);
+        std::fs::write(&path, [0u8; 33]).unwrap();
+        assert!(read_rays(&path)
+            .unwrap_err()
+            .to_string()
+            .contains("multiple of 32"));
+        std::fs::write(&path, []).unwrap();
+        assert!(read_rays(&path).is_err());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn random_sets_are_well_formed() {
+        let scene = crate::scene::builtin::builtin_scene("cornell-box").unwrap();
+        for r in random_segments(&scene, 500, 3) {
+            assert!((Vec3::from(r.dir).length() - 1.0).abs() < 1e-5 && r.tmax > 0.0);
+        }
+        for r in random_rays(&scene, 500, 3) {
+            assert!((Vec3::from(r.dir).length() - 1.0).abs() < 1e-5 && r.tmax == RAY_INFINITY);
+        }
+    }
+}
