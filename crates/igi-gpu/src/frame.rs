@@ -535,9 +535,10 @@ impl Renderer {
     }
 
     /// The VPL shadow rays of a real frame of `settings` (canonical: every pixel against
-    /// every VPL, exactly the segments the indirect pass traces), at most `count`, taken
-    /// from pixels spread over the whole image (every k-th pixel in scanline order, so
-    /// that each pixel keeps its rays to all VPLs together, as in the frame).
+    /// every VPL, exactly the segments the indirect pass traces), about `count` of them:
+    /// when the frame has more, an evenly spread subset of its pixels keeps all its rays.
+    /// Ordered VPL by VPL, each over the pixels in scanline order, as neighbouring threads
+    /// of the indirect pass trace them (all towards one VPL at a time).
     pub fn frame_shadow_rays(
         &mut self,
         ctx: &GpuContext,
@@ -560,56 +561,50 @@ impl Renderer {
         let m = settings
             .min_dist
             .unwrap_or(igi_core::settings::DEFAULT_MIN_DIST_FRACTION * self.diagonal);
-        let pixels = (settings.width * settings.height) as usize;
-        let rays_of = |p: usize, out: &mut Vec<igi_core::rays::RayRecord>| {
-            if positions[p][3] <= 0.0 {
-                return;
-            }
+        let pixels: Vec<usize> = (0..(settings.width * settings.height) as usize)
+            .filter(|&p| positions[p][3] > 0.0)
+            .collect();
+        // The segment from pixel p to VPL v, if the indirect pass traces it.
+        let segment = |p: usize, v: &Vpl| -> Option<igi_core::rays::RayRecord> {
             let x = Vec3::from_slice(&positions[p][..3]);
             let ns = Vec3::from_slice(&normals[p][..3]);
             let ng = Vec3::from_slice(&geometric[p][..3]);
-            let origin = offset_ray_origin(x, ng);
-            for v in &vpls {
-                let y = Vec3::from(v.position);
-                let ny = Vec3::from(v.normal);
-                let d = y - x;
-                let dist2 = d.length_squared();
-                let dist = dist2.sqrt();
-                let (cos_x, cos_y) = (ns.dot(d) / dist, -ny.dot(d) / dist);
-                if cos_x <= 0.0 || cos_y <= 0.0 || ng.dot(d) <= 0.0 {
-                    continue;
-                }
-                let bound = match settings.geometry_bound {
-                    GeometryBound::Clamp => 1.0,
-                    GeometryBound::Smoothstep => {
-                        let t = ((dist - 0.8 * m) / (0.4 * m)).clamp(0.0, 1.0);
-                        t * t * (3.0 - 2.0 * t)
-                    }
-                };
-                if bound <= 0.0 {
-                    continue;
-                }
-                out.push(igi_core::rays::RayRecord::segment(
-                    origin,
-                    offset_ray_origin(y, ny),
-                ));
+            let (y, ny) = (Vec3::from(v.position), Vec3::from(v.normal));
+            let d = y - x;
+            let dist = d.length();
+            if ns.dot(d) <= 0.0 || -ny.dot(d) <= 0.0 || ng.dot(d) <= 0.0 {
+                return None;
             }
+            if settings.geometry_bound == GeometryBound::Smoothstep && dist <= 0.8 * m {
+                return None;
+            }
+            Some(igi_core::rays::RayRecord::segment(
+                offset_ray_origin(x, ng),
+                offset_ray_origin(y, ny),
+            ))
         };
-        // Count first, then take every k-th pixel.
-        let mut all = 0usize;
-        let mut scratch = vec![];
-        for p in 0..pixels {
-            scratch.clear();
-            rays_of(p, &mut scratch);
-            all += scratch.len();
-        }
-        let stride = all.div_ceil(count.max(1)).max(1);
+        let all: usize = pixels
+            .iter()
+            .map(|&p| vpls.iter().filter(|v| segment(p, v).is_some()).count())
+            .sum();
+        // Keep an evenly spread fraction of the pixels (error diffusion along scanlines).
+        let fraction = (count as f64 / all.max(1) as f64).min(1.0);
+        let mut carry = 0.0;
+        let kept: Vec<usize> = pixels
+            .into_iter()
+            .filter(|_| {
+                carry += fraction;
+                if carry >= 1.0 - 1e-9 {
+                    carry -= 1.0;
+                    true
+                } else {
+                    false
+                }
+            })
+            .collect();
         let mut out = Vec::with_capacity(count.min(all));
-        for p in (0..pixels).step_by(stride) {
-            rays_of(p, &mut out);
-            if out.len() >= count {
-                break;
-            }
+        for v in &vpls {
+            out.extend(kept.iter().filter_map(|&p| segment(p, v)));
         }
         out.truncate(count);
         Ok(out)

@@ -12,6 +12,9 @@ use igi_core::bvh::Bvh;
 use igi_core::rays::RayRecord;
 use igi_core::scene::Scene;
 
+/// Untimed runs before the timed ones.
+pub const WARMUP_RUNS: u32 = 3;
+
 /// Threads per workgroup of the ray kernels (`RAY_GROUP` in rays.wgsl).
 const RAY_GROUP: u32 = 64;
 
@@ -70,7 +73,8 @@ impl RayBench {
         })
     }
 
-    /// Trace `rays` once untimed, then `runs` times timed; results of the last run.
+    /// Trace `rays` [`WARMUP_RUNS`] times untimed (the GPU's clocks rise meanwhile), then
+    /// `runs` times timed; results of the last run.
     pub fn trace(
         &self,
         ctx: &GpuContext,
@@ -100,7 +104,7 @@ impl RayBench {
         };
         let profiler = Profiler::new(ctx, 1);
         let mut runs_ms = vec![];
-        for run in 0..=runs {
+        for run in 0..WARMUP_RUNS + runs {
             let mut encoder = ctx.device.create_command_encoder(&Default::default());
             {
                 let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
@@ -119,7 +123,7 @@ impl RayBench {
             profiler.resolve(&mut encoder, 1);
             ctx.queue.submit([encoder.finish()]);
             if let Some((_, ms)) = profiler.read(ctx, &["rays"])? {
-                if run > 0 {
+                if run >= WARMUP_RUNS {
                     runs_ms.push(ms);
                 }
             }
