@@ -62,9 +62,9 @@ pub struct Hit {
     pub t: f32,
     /// BVH slot of the triangle ([`Bvh::tri_order`] maps it to the input index).
     pub tri: u32,
-    /// Barycentric coordinate of vertex 1 (v[1]) at the hit point.
+    /// Barycentric coordinate of vertex 1 (`v[1]`) at the hit point.
     pub u: f32,
-    /// Barycentric coordinate of vertex 2 (v[2]); vertex 0 has 1 - u - v.
+    /// Barycentric coordinate of vertex 2 (`v[2]`); vertex 0 has 1 - u - v.
     pub v: f32,
 }
 
