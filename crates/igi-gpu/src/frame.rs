@@ -92,6 +92,8 @@ pub struct Renderer {
     diagonal: f32,
     /// Paths per frame for (seed, vpls, bounces, mirror depth), from the pilot run.
     path_cache: Option<((u32, u32, u32, u32), u32)>,
+    /// Whether the adapter is a software one (see `passes::indirect::lanes_for`).
+    software: bool,
     /// Whether the next frame counts its rays (see [`Renderer::count_rays`]).
     counting: bool,
 }
@@ -159,6 +161,7 @@ impl Renderer {
             diagonal: scene.diagonal(),
             path_cache: None,
             counting: false,
+            software: ctx.info.device_type == wgpu::DeviceType::Cpu,
         };
         ctx.check()?;
         Ok(renderer)
@@ -712,7 +715,7 @@ impl Renderer {
             p,
             i,
             "indirect",
-            &self.indirect.steps(low.0, low.1, iv),
+            &self.indirect.steps(low.0, low.1, iv, self.software),
             scene,
             &indirect_bind,
             Some(&ranges),

@@ -35,7 +35,9 @@ impl DirectPass {
             pipelines: GatherPipelines::new(
                 device,
                 "direct",
+                "main",
                 &[scene_layout, &layout, range_layout],
+                &[],
             ),
             layout,
         }

@@ -65,16 +65,14 @@ impl GatherPipelines {
     pub(crate) fn new(
         device: &wgpu::Device,
         name: &str,
+        entry: &str,
         layouts: &[&wgpu::BindGroupLayout],
+        constants: &[(&str, f64)],
     ) -> GatherPipelines {
         let build = |iv: f64| {
-            pipeline_with_constants(
-                device,
-                name,
-                "main",
-                layouts,
-                &[("IMPERFECT_VISIBILITY", iv)],
-            )
+            let mut all = vec![("IMPERFECT_VISIBILITY", iv)];
+            all.extend_from_slice(constants);
+            pipeline_with_constants(device, name, entry, layouts, &all)
         };
         GatherPipelines {
             exact: build(0.0),

@@ -39,26 +39,75 @@ fn interleave_subset(x: u32, y: u32) -> u32 {
     return perm[local];
 }
 
+// One pixel's share of E: its subset's VPLs from `lane` on, every `lanes`-th.
+fn pixel_sum(x: u32, y: u32, lane: u32, lanes: u32) -> vec3<f32> {
+    let pixel = representative_pixel(x, y);
+    let position = gbuf_position[pixel];
+    if (position.w <= 0.0) {
+        return vec3<f32>(0.0);
+    }
+    let subsets = params.interleave_n * params.interleave_m;
+    let subset = interleave_subset(x, y);
+    // First VPL of this pixel's subset within the dispatch's range, then this lane's.
+    let begin = gather_first();
+    let first = begin + (subset + subsets - begin % subsets) % subsets + lane * subsets;
+    return vpl_irradiance(position.xyz, gbuf_geometric[pixel].xyz, gbuf_normal[pixel].xyz, first, gather_last(), subsets * lanes);
+}
+
+// Add this dispatch's sum to what earlier VPL ranges left, scaled by the subset count.
+fn store_irradiance(x: u32, y: u32, sum: vec3<f32>) {
+    let low = y * params.low_width + x;
+    var e = vec3<f32>(0.0);
+    if (gather_first() > 0u) {
+        e = irradiance_out[low].xyz;
+    }
+    irradiance_out[low] = vec4<f32>(e + f32(params.interleave_n * params.interleave_m) * sum, 1.0);
+}
+
+// One thread per pixel, 8 x 8 pixels per workgroup.
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (gid.x >= params.low_width || gid.y >= params.low_height) {
         return;
     }
-    let low = gid.y * params.low_width + gid.x;
-    let pixel = representative_pixel(gid.x, gid.y);
-    let position = gbuf_position[pixel];
-    var e = vec3<f32>(0.0);
-    if (gather_first() > 0u) {
-        e = irradiance_out[low].xyz;
+    store_irradiance(gid.x, gid.y, pixel_sum(gid.x, gid.y, 0u, 1u));
+}
+
+// Threads that share one pixel's VPL loop in `main_lanes` (a pipeline constant: 2, 4,
+// 8, ...). A downsampled image has too few pixels to fill a big GPU with one thread
+// each, so each pixel's VPLs are split over lanes, and lane 0 adds the lanes' sums in
+// lane order (the same image every run).
+override VPL_LANES: u32 = 8u;
+
+var<workgroup> lane_sums: array<vec4<f32>, 64>;
+
+// Pixels of a workgroup laid out as a tile as square as possible (4 x 2 for 8 lanes).
+fn tile_width() -> u32 {
+    let pixels = 64u / VPL_LANES;
+    return 1u << ((firstTrailingBit(pixels) + 1u) / 2u);
+}
+
+@compute @workgroup_size(64)
+fn main_lanes(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) l: u32) {
+    let lanes = VPL_LANES;
+    let slot = l / lanes;
+    let lane = l % lanes;
+    let tw = tile_width();
+    let th = (64u / lanes) / tw;
+    let x = group.x * tw + slot % tw;
+    let y = group.y * th + slot / tw;
+    let inside = x < params.low_width && y < params.low_height;
+    var sum = vec3<f32>(0.0);
+    if (inside) {
+        sum = pixel_sum(x, y, lane, lanes);
     }
-    if (position.w > 0.0) {
-        let subsets = params.interleave_n * params.interleave_m;
-        let subset = interleave_subset(gid.x, gid.y);
-        // First VPL of this pixel's subset within the dispatch's range.
-        let begin = gather_first();
-        let first = begin + (subset + subsets - begin % subsets) % subsets;
-        let sum = vpl_irradiance(position.xyz, gbuf_geometric[pixel].xyz, gbuf_normal[pixel].xyz, first, gather_last(), subsets);
-        e += f32(subsets) * sum;
+    lane_sums[l] = vec4<f32>(sum, 0.0);
+    workgroupBarrier();
+    if (inside && lane == 0u) {
+        var total = vec3<f32>(0.0);
+        for (var i = 0u; i < lanes; i += 1u) {
+            total += lane_sums[l + i].xyz;
+        }
+        store_irradiance(x, y, total);
     }
-    irradiance_out[low] = vec4<f32>(e, 1.0);
 }

@@ -347,7 +347,7 @@ pub fn to_markdown(results: &BenchResults) -> String {
         if short {
             let _ = writeln!(
                 s,
-                "\n† Fewer VPLs than asked were reached (`vpl_count` in results.csv)."
+                "\n† The VPL count reached differs from the count asked (the number of light paths is fixed in advance from a pilot run; `vpl_count` in results.csv)."
             );
         }
 
