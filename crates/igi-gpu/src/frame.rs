@@ -9,6 +9,7 @@ use crate::passes::compose::ComposePass;
 use crate::passes::direct::{DirectBindings, DirectPass};
 use crate::passes::filter::{Filter, FilterPass};
 use crate::passes::indirect::IndirectPass;
+use crate::passes::mirror::MirrorPass;
 use crate::passes::vpl::VplPass;
 use crate::passes::{dispatch, gather_range_layout, GatherRanges, GATHER_RANGE_STRIDE};
 use crate::profiler::{Profiler, StageTime};
@@ -21,9 +22,9 @@ use igi_core::settings::{
     Accelerations, FilterMode, GeometryBound, InterleavePattern, OutputBuffer, RenderSettings,
 };
 
-/// Most stages a frame can have (vpl, direct, indirect, two filters, compose), each
-/// with its timestamp pair.
-pub const MAX_STAGES: u32 = 6;
+/// Most stages a frame can have (vpl, direct, mirror indirect, indirect, two filters,
+/// compose), each with its timestamp pair.
+pub const MAX_STAGES: u32 = 7;
 
 /// Light paths of the pilot run that estimates VPLs per path.
 pub const PILOT_PATHS: u32 = 4096;
@@ -52,6 +53,9 @@ struct ImageBuffers {
     normal: wgpu::Buffer,
     geometric: wgpu::Buffer,
     albedo: wgpu::Buffer,
+    /// The first diffuse hit of each pixel's mirror chain: position, shading normal,
+    /// geometric normal, weight (mirror.wgsl).
+    mirror: [wgpu::Buffer; 4],
     /// E at the indirect resolution, as the indirect pass leaves it.
     irradiance: wgpu::Buffer,
     /// After the discontinuity buffer (indirect resolution).
@@ -73,6 +77,7 @@ pub struct Renderer {
     vpl: VplPass,
     direct: DirectPass,
     indirect: IndirectPass,
+    mirror: MirrorPass,
     filter: FilterPass,
     compose: ComposePass,
     profiler: Profiler,
@@ -92,6 +97,8 @@ pub struct Renderer {
     diagonal: f32,
     /// Paths per frame for (seed, vpls, bounces, mirror depth), from the pilot run.
     path_cache: Option<((u32, u32, u32, u32), u32)>,
+    /// Whether any material has a mirror part (else the mirror stage is skipped).
+    has_mirrors: bool,
     /// Whether the adapter is a software one (see `passes::indirect::lanes_for`).
     software: bool,
     /// Whether the next frame counts its rays (see [`Renderer::count_rays`]).
@@ -138,6 +145,7 @@ impl Renderer {
             vpl: VplPass::new(device, layout),
             direct: DirectPass::new(device, layout, &range_layout),
             indirect: IndirectPass::new(device, layout, &range_layout),
+            mirror: MirrorPass::new(device, layout, &range_layout),
             range_layout,
             range_buffer: None,
             vpls_per_dispatch: ctx.vpls_per_dispatch(),
@@ -162,6 +170,7 @@ impl Renderer {
             path_cache: None,
             counting: false,
             software: ctx.info.device_type == wgpu::DeviceType::Cpu,
+            has_mirrors: scene.materials.iter().any(|m| m.mirror.max_element() > 0.0),
         };
         ctx.check()?;
         Ok(renderer)
@@ -182,6 +191,10 @@ impl Renderer {
                 &b.geometric,
                 &b.albedo,
                 &b.irradiance,
+                &b.mirror[0],
+                &b.mirror[1],
+                &b.mirror[2],
+                &b.mirror[3],
                 &b.filtered_low,
                 &b.filtered,
                 &b.color,
@@ -230,6 +243,12 @@ impl Renderer {
             normal: storage(device, "gbuffer normal", size),
             geometric: storage(device, "gbuffer geometric normal", size),
             albedo: storage(device, "gbuffer albedo", size),
+            mirror: [
+                storage(device, "mirror position", size),
+                storage(device, "mirror normal", size),
+                storage(device, "mirror geometric normal", size),
+                storage(device, "mirror weight", size),
+            ],
             irradiance: storage(device, "irradiance", size),
             filtered_low: storage(device, "irradiance after discontinuity", size),
             filtered: storage(device, "irradiance full resolution", size),
@@ -683,6 +702,12 @@ impl Renderer {
                 normal: &img.normal,
                 geometric: &img.geometric,
                 albedo: &img.albedo,
+                mirror: [
+                    &img.mirror[0],
+                    &img.mirror[1],
+                    &img.mirror[2],
+                    &img.mirror[3],
+                ],
             },
         );
         let i = stage("direct + specular");
@@ -696,6 +721,34 @@ impl Renderer {
             &direct_bind,
             Some(&ranges),
         );
+
+        // Scenes without mirrors have no mirrored hits: no stage.
+        if self.has_mirrors {
+            let mirror_bind = self.mirror.bind(
+                device,
+                &[
+                    &self.params,
+                    &vb.vpls,
+                    &self.vpl_header,
+                    &img.mirror[0],
+                    &img.mirror[1],
+                    &img.mirror[2],
+                    &img.mirror[3],
+                    &img.direct,
+                ],
+            );
+            let i = stage("mirror indirect");
+            dispatch(
+                encoder,
+                p,
+                i,
+                "mirror indirect",
+                &self.mirror.steps(full.0, full.1, iv, self.software),
+                scene,
+                &mirror_bind,
+                Some(&ranges),
+            );
+        }
 
         let indirect_bind = self.indirect.bind(
             device,

@@ -18,6 +18,8 @@ pub struct DirectBindings<'a> {
     pub normal: &'a wgpu::Buffer,
     pub geometric: &'a wgpu::Buffer,
     pub albedo: &'a wgpu::Buffer,
+    /// The mirrored-hit record (see mirror.wgsl).
+    pub mirror: [&'a wgpu::Buffer; 4],
 }
 
 impl DirectPass {
@@ -29,7 +31,9 @@ impl DirectPass {
         let layout = pass_layout(
             device,
             "direct",
-            &[UNIFORM, READ, READ, WRITE, WRITE, WRITE, WRITE, WRITE],
+            &[
+                UNIFORM, READ, READ, WRITE, WRITE, WRITE, WRITE, WRITE, WRITE, WRITE, WRITE, WRITE,
+            ],
         );
         DirectPass {
             pipelines: GatherPipelines::new(
@@ -62,6 +66,10 @@ impl DirectPass {
                 b.normal,
                 b.geometric,
                 b.albedo,
+                b.mirror[0],
+                b.mirror[1],
+                b.mirror[2],
+                b.mirror[3],
             ],
         )
     }

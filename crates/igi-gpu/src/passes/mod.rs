@@ -6,6 +6,7 @@ pub mod compose;
 pub mod direct;
 pub mod filter;
 pub mod indirect;
+pub mod mirror;
 pub mod vpl;
 
 use crate::profiler::Profiler;
@@ -34,6 +35,11 @@ pub const SOURCES: &[PassSource] = &[
     PassSource {
         name: "indirect",
         wgsl: include_str!("../shaders/indirect.wgsl"),
+        gathers: true,
+    },
+    PassSource {
+        name: "mirror",
+        wgsl: include_str!("../shaders/mirror.wgsl"),
         gathers: true,
     },
     PassSource {
@@ -86,6 +92,88 @@ impl GatherPipelines {
         } else {
             &self.exact
         }
+    }
+}
+
+/// VPL lanes per pixel the gathering passes are built for (`VPL_LANES` of gather.wgsl).
+pub const LANE_CHOICES: [u32; 2] = [1, 8];
+
+/// Below this many pixels of the indirect term, each pixel's VPLs are split over 8 lanes:
+/// a downsampled 800 x 600 frame (30000 pixels) is a few hundred warps, far from filling
+/// a large GPU; full resolution (480000) fills it with one lane. `IGI_VPL_LANES` (1 or 8)
+/// overrides the choice, for measurements.
+pub const LANES_BELOW_PIXELS: u32 = 200_000;
+
+/// The lanes a gathering pass uses over `pixels` pixels; always one
+/// on a software adapter, which has few threads to fill and whose workgroup barriers are
+/// slow.
+pub fn lanes_for(pixels: u32, software: bool) -> u32 {
+    if let Some(l) = std::env::var("IGI_VPL_LANES")
+        .ok()
+        .and_then(|v| v.parse::<u32>().ok())
+    {
+        if LANE_CHOICES.contains(&l) {
+            return l;
+        }
+    }
+    if pixels < LANES_BELOW_PIXELS && !software {
+        8
+    } else {
+        1
+    }
+}
+
+/// A gathering pass built for each entry of [`LANE_CHOICES`]: entry point `main` (one
+/// thread per pixel, 8 x 8 per workgroup) and `main_lanes` (64 threads per workgroup,
+/// VPL_LANES per pixel), each with and without imperfect visibility.
+pub(crate) struct LanePipelines {
+    by_lanes: Vec<GatherPipelines>,
+}
+
+impl LanePipelines {
+    pub(crate) fn new(
+        device: &wgpu::Device,
+        name: &str,
+        layouts: &[&wgpu::BindGroupLayout],
+    ) -> LanePipelines {
+        LanePipelines {
+            by_lanes: LANE_CHOICES
+                .iter()
+                .map(|&lanes| {
+                    if lanes == 1 {
+                        GatherPipelines::new(device, name, "main", layouts, &[])
+                    } else {
+                        GatherPipelines::new(
+                            device,
+                            name,
+                            "main_lanes",
+                            layouts,
+                            &[("VPL_LANES", lanes as f64)],
+                        )
+                    }
+                })
+                .collect(),
+        }
+    }
+
+    /// The dispatch over `width` x `height` pixels.
+    pub(crate) fn step(
+        &self,
+        width: u32,
+        height: u32,
+        imperfect_visibility: bool,
+        software: bool,
+    ) -> (&wgpu::ComputePipeline, [u32; 3]) {
+        let lanes = lanes_for(width * height, software);
+        let index = LANE_CHOICES.iter().position(|&l| l == lanes).unwrap_or(0);
+        // 8 x 8 pixels with one lane, else a tile of 64 / lanes (lane_pixel of gather.wgsl).
+        let pixels = 64 / lanes;
+        let tile_w = 1u32 << pixels.trailing_zeros().div_ceil(2);
+        let tile_h = pixels / tile_w;
+        (
+            self.by_lanes[index].get(imperfect_visibility),
+            [width.div_ceil(tile_w), height.div_ceil(tile_h), 1],
+        )
     }
 }
 

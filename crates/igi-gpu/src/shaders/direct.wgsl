@@ -1,8 +1,10 @@
 // direct.wgsl: direct + specular at full resolution (paper section 4, second stage). One
 // primary ray per pixel; at each hit the point lights add (rho_d / pi) I V cos / d^2, a
 // mirror part continues the Whitted tree up to the depth limit, and at hits reached
-// through mirrors the indirect diffuse term is gathered here from the full VPL set (no
-// screen-space pass reaches them). Writes the G-buffer of the primary hit.
+// through mirrors the indirect diffuse term comes from the full VPL set (no screen-space
+// pass reaches them): at the first such hit it is gathered by mirror.wgsl from the
+// record written here, at any later one (a mirror seen in a mirror) here. Writes the
+// G-buffer of the primary hit.
 // When the VPL list is gathered in several ranges (see gather.wgsl), the first dispatch
 // does everything and later ones walk the mirror chain again, adding only their range's
 // indirect light at mirrored hits.
@@ -16,6 +18,11 @@
 @group(1) @binding(5) var<storage, read_write> gbuf_normal: array<vec4<f32>>;
 @group(1) @binding(6) var<storage, read_write> gbuf_geometric: array<vec4<f32>>;
 @group(1) @binding(7) var<storage, read_write> gbuf_albedo: array<vec4<f32>>;
+// The first diffuse hit of the pixel's mirror chain, for mirror.wgsl to gather at.
+@group(1) @binding(8) var<storage, read_write> mirror_position: array<vec4<f32>>;
+@group(1) @binding(9) var<storage, read_write> mirror_normal: array<vec4<f32>>;
+@group(1) @binding(10) var<storage, read_write> mirror_geometric: array<vec4<f32>>;
+@group(1) @binding(11) var<storage, read_write> mirror_weight: array<vec4<f32>>;
 
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
@@ -33,6 +40,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         gbuf_normal[pixel] = vec4<f32>(0.0);
         gbuf_geometric[pixel] = vec4<f32>(0.0);
         gbuf_albedo[pixel] = vec4<f32>(0.0);
+        mirror_position[pixel] = vec4<f32>(0.0);
     } else {
         // Later ranges only add light at mirrored hits: nothing to do without a mirror.
         if (gbuf_albedo[pixel].w == 0.0) {
@@ -41,6 +49,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         radiance = direct_out[pixel].xyz;
     }
     var traced = 0u;
+    var recorded = false;
     for (var depth = 0u; depth <= params.mirror_depth; depth += 1u) {
         let hit = trace_closest(origin, dir, INFINITY);
         traced += 1u;
@@ -61,10 +70,19 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             if (first_range) {
                 e = direct_irradiance(s.position, s.geometric_normal, s.shading_normal);
             }
-            if (depth > 0u) {
+            let weight = throughput * s.diffuse / PI;
+            if (depth > 0u && !recorded) {
+                recorded = true;
+                if (first_range) {
+                    mirror_position[pixel] = vec4<f32>(s.position, 1.0);
+                    mirror_normal[pixel] = vec4<f32>(s.shading_normal, 0.0);
+                    mirror_geometric[pixel] = vec4<f32>(s.geometric_normal, 0.0);
+                    mirror_weight[pixel] = vec4<f32>(weight, 0.0);
+                }
+            } else if (depth > 0u) {
                 e += vpl_irradiance(s.position, s.geometric_normal, s.shading_normal, gather_first(), gather_last(), 1u);
             }
-            radiance += throughput * s.diffuse / PI * e;
+            radiance += weight * e;
         }
         if (max(s.mirror.x, max(s.mirror.y, s.mirror.z)) <= 0.0) {
             break;

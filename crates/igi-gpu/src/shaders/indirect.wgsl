@@ -73,41 +73,19 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     store_irradiance(gid.x, gid.y, pixel_sum(gid.x, gid.y, 0u, 1u));
 }
 
-// Threads that share one pixel's VPL loop in `main_lanes` (a pipeline constant: 2, 4,
-// 8, ...). A downsampled image has too few pixels to fill a big GPU with one thread
-// each, so each pixel's VPLs are split over lanes, and lane 0 adds the lanes' sums in
-// lane order (the same image every run).
-override VPL_LANES: u32 = 8u;
-
-var<workgroup> lane_sums: array<vec4<f32>, 64>;
-
-// Pixels of a workgroup laid out as a tile as square as possible (4 x 2 for 8 lanes).
-fn tile_width() -> u32 {
-    let pixels = 64u / VPL_LANES;
-    return 1u << ((firstTrailingBit(pixels) + 1u) / 2u);
-}
-
+// Each pixel's VPLs split over VPL_LANES threads (see gather.wgsl).
 @compute @workgroup_size(64)
 fn main_lanes(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) l: u32) {
-    let lanes = VPL_LANES;
-    let slot = l / lanes;
-    let lane = l % lanes;
-    let tw = tile_width();
-    let th = (64u / lanes) / tw;
-    let x = group.x * tw + slot % tw;
-    let y = group.y * th + slot / tw;
-    let inside = x < params.low_width && y < params.low_height;
+    let p = lane_pixel(group, l);
+    let lane = l % VPL_LANES;
+    let inside = p.x < params.low_width && p.y < params.low_height;
     var sum = vec3<f32>(0.0);
     if (inside) {
-        sum = pixel_sum(x, y, lane, lanes);
+        sum = pixel_sum(p.x, p.y, lane, VPL_LANES);
     }
     lane_sums[l] = vec4<f32>(sum, 0.0);
     workgroupBarrier();
     if (inside && lane == 0u) {
-        var total = vec3<f32>(0.0);
-        for (var i = 0u; i < lanes; i += 1u) {
-            total += lane_sums[l + i].xyz;
-        }
-        store_irradiance(x, y, total);
+        store_irradiance(p.x, p.y, lanes_total(l));
     }
 }

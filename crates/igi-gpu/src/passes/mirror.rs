@@ -1,0 +1,47 @@
+//! Indirect diffuse light at hits seen through mirrors (paper section 4; its cost is the
+//! paper's future work): gathered from every VPL at the first diffuse hit of each
+//! pixel's mirror chain, recorded by the direct pass. See `shaders/mirror.wgsl`.
+
+use super::{bind, pass_layout, LanePipelines};
+use crate::scene_buffers::{READ, UNIFORM, WRITE};
+
+pub struct MirrorPass {
+    pub layout: wgpu::BindGroupLayout,
+    pipelines: LanePipelines,
+}
+
+impl MirrorPass {
+    pub fn new(
+        device: &wgpu::Device,
+        scene_layout: &wgpu::BindGroupLayout,
+        range_layout: &wgpu::BindGroupLayout,
+    ) -> MirrorPass {
+        // params, vpls, vpl_header, mirror position, normal, geometric, weight, direct
+        let layout = pass_layout(
+            device,
+            "mirror",
+            &[UNIFORM, READ, READ, READ, READ, READ, READ, WRITE],
+        );
+        MirrorPass {
+            pipelines: LanePipelines::new(device, "mirror", &[scene_layout, &layout, range_layout]),
+            layout,
+        }
+    }
+
+    pub fn bind(&self, device: &wgpu::Device, buffers: &[&wgpu::Buffer; 8]) -> wgpu::BindGroup {
+        bind(device, "mirror", &self.layout, buffers)
+    }
+
+    /// The dispatch over the full-resolution image.
+    pub fn steps(
+        &self,
+        width: u32,
+        height: u32,
+        imperfect_visibility: bool,
+        software: bool,
+    ) -> [(&wgpu::ComputePipeline, [u32; 3]); 1] {
+        [self
+            .pipelines
+            .step(width, height, imperfect_visibility, software)]
+    }
+}
