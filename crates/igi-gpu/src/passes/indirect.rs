@@ -43,8 +43,11 @@ impl IndirectPass {
         imperfect_visibility: bool,
         software: bool,
     ) -> [(&wgpu::ComputePipeline, [u32; 3]); 1] {
-        [self
-            .pipelines
-            .step(width, height, imperfect_visibility, software)]
+        [self.pipelines.step(
+            width,
+            height,
+            imperfect_visibility,
+            super::lanes_for(width * height, software),
+        )]
     }
 }

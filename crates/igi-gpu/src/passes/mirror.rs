@@ -5,6 +5,25 @@
 use super::{bind, pass_layout, LanePipelines};
 use crate::scene_buffers::{READ, UNIFORM, WRITE};
 
+/// Lanes per pixel of the mirror pass: few pixels see a mirror (18000 of 480000 in the
+/// conference room), so their VPL loops are split widely; one lane on a software adapter.
+/// `IGI_MIRROR_LANES` (1, 8 or 32) overrides it, for measurements.
+pub fn mirror_lanes(software: bool) -> u32 {
+    if let Some(l) = std::env::var("IGI_MIRROR_LANES")
+        .ok()
+        .and_then(|v| v.parse::<u32>().ok())
+    {
+        if super::LANE_CHOICES.contains(&l) {
+            return l;
+        }
+    }
+    if software {
+        1
+    } else {
+        32
+    }
+}
+
 pub struct MirrorPass {
     pub layout: wgpu::BindGroupLayout,
     pipelines: LanePipelines,
@@ -42,6 +61,6 @@ impl MirrorPass {
     ) -> [(&wgpu::ComputePipeline, [u32; 3]); 1] {
         [self
             .pipelines
-            .step(width, height, imperfect_visibility, software)]
+            .step(width, height, imperfect_visibility, mirror_lanes(software))]
     }
 }

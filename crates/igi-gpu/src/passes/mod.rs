@@ -96,7 +96,7 @@ impl GatherPipelines {
 }
 
 /// VPL lanes per pixel the gathering passes are built for (`VPL_LANES` of gather.wgsl).
-pub const LANE_CHOICES: [u32; 2] = [1, 8];
+pub const LANE_CHOICES: [u32; 3] = [1, 8, 32];
 
 /// Below this many pixels of the indirect term, each pixel's VPLs are split over 8 lanes:
 /// a downsampled 800 x 600 frame (30000 pixels) is a few hundred warps, far from filling
@@ -156,15 +156,15 @@ impl LanePipelines {
         }
     }
 
-    /// The dispatch over `width` x `height` pixels.
+    /// The dispatch over `width` x `height` pixels with `lanes` lanes per pixel (one of
+    /// [`LANE_CHOICES`]).
     pub(crate) fn step(
         &self,
         width: u32,
         height: u32,
         imperfect_visibility: bool,
-        software: bool,
+        lanes: u32,
     ) -> (&wgpu::ComputePipeline, [u32; 3]) {
-        let lanes = lanes_for(width * height, software);
         let index = LANE_CHOICES.iter().position(|&l| l == lanes).unwrap_or(0);
         // 8 x 8 pixels with one lane, else a tile of 64 / lanes (lane_pixel of gather.wgsl).
         let pixels = 64 / lanes;
