@@ -549,12 +549,7 @@ fn bench_rays(args: &RaysArgs) -> Result<()> {
     if args.set == RaySetArg::Frame && args.kind != RayKindArg::Shadow && args.load.is_none() {
         bail!("the frame set holds shadow rays: use --kind shadow");
     }
-    let scene = match args.scene.strip_prefix("builtin:") {
-        Some(name) => {
-            builtin::builtin_scene(name).with_context(|| format!("no built-in scene '{name}'"))?
-        }
-        None => load_scene(std::path::Path::new(&args.scene))?,
-    };
+    let scene = igi::bench::run::load(&args.scene)?;
     let t = Instant::now();
     let bvh = Bvh::build(&scene.triangles);
     let bvh_ms = t.elapsed().as_secs_f64() * 1e3;

@@ -87,7 +87,8 @@ pub fn scene_name(arg: &str) -> String {
     stem
 }
 
-fn load(arg: &str) -> Result<Scene> {
+/// Load a scene argument: `builtin:NAME` or a scene file.
+pub fn load(arg: &str) -> Result<Scene> {
     match arg.strip_prefix("builtin:") {
         Some(name) => builtin::builtin_scene(name).with_context(|| {
             format!(
