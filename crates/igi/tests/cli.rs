@@ -323,3 +323,33 @@ fn bench_rays_saves_and_loads_the_same_rays() {
     ]);
     assert_one_error_line(&bad, &["rays.bin", "multiple of 32"]);
 }
+
+#[test]
+fn image_sizes_of_zero_or_beyond_the_adapter_are_clear_errors() {
+    let zero = igi(&[
+        "render",
+        "--builtin",
+        "cornell-box",
+        "--width",
+        "0",
+        "-o",
+        "/tmp/igi-zero.png",
+    ]);
+    if skipped_for_no_adapter(&zero) {
+        return;
+    }
+    assert_one_error_line(&zero, &["0x512"]);
+    let huge = igi(&[
+        "render",
+        "--builtin",
+        "cornell-box",
+        "--width",
+        "200000",
+        "--height",
+        "200000",
+        "-o",
+        "/tmp/igi-huge.png",
+    ]);
+    assert_one_error_line(&huge, &["200000x200000", "max_storage_buffer_binding_size"]);
+    assert!(!std::path::Path::new("/tmp/igi-huge.png").exists());
+}
