@@ -388,6 +388,7 @@ fn read(bytes: &[u8], path: &Path, file: &str) -> Result<GltfMesh, SceneError> {
         out: GltfMesh::default(),
         materials: HashMap::new(),
         textures: HashMap::new(),
+        bad_images: image_problems(&document),
         warn: Warnings::default(),
     };
     r.load_buffers(&document, blob)?;
@@ -400,6 +401,21 @@ fn read(bytes: &[u8], path: &Path, file: &str) -> Result<GltfMesh, SceneError> {
     r.scene(&document, &scene)?;
     r.warn.log(file);
     Ok(r.out)
+}
+
+/// Images that `Image::source()` of gltf 1.4 would `unwrap()` a `None` of: it assumes a
+/// `uri` when there is no `bufferView`, and a `mimeType` when there is one (a fuzzing find).
+fn image_problems(doc: &::gltf::Document) -> HashMap<usize, &'static str> {
+    let images = doc.as_json().images.iter().enumerate();
+    images
+        .filter_map(
+            |(i, img)| match (&img.buffer_view, &img.uri, &img.mime_type) {
+                (None, None, _) => Some((i, "the image has neither uri nor bufferView")),
+                (Some(_), _, None) => Some((i, "the image has a bufferView but no mimeType")),
+                _ => None,
+            },
+        )
+        .collect()
 }
 
 /// Things skipped or repaired, reported once per file.
@@ -467,6 +483,9 @@ struct Reader {
     materials: HashMap<Option<usize>, usize>,
     /// Image index -> average linear colour (`None`: could not be decoded).
     textures: HashMap<usize, Option<Vec3>>,
+    /// Images whose `Image::source()` would panic in the gltf crate (found by fuzzing:
+    /// neither `uri` nor `bufferView`, or a `bufferView` without `mimeType`), with why.
+    bad_images: HashMap<usize, &'static str>,
     warn: Warnings,
 }
 
@@ -846,6 +865,9 @@ impl Reader {
 
     fn decode(&mut self, image: &::gltf::image::Image) -> Result<::gltf::image::Data, String> {
         use ::gltf::image::Source;
+        if let Some(&why) = self.bad_images.get(&image.index()) {
+            return Err(why.to_string());
+        }
         let mut file = None;
         match image.source() {
             Source::View { view, .. } => {
