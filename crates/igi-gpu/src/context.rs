@@ -62,6 +62,8 @@ pub struct GpuContext {
     pub timestamps: bool,
     /// The first uncaptured error (validation, out of memory) seen on the device, if any.
     errors: Arc<Mutex<Option<String>>>,
+    /// Why the device was lost, if it was: reported before any error it causes.
+    lost: Arc<Mutex<Option<String>>>,
 }
 
 fn instance() -> wgpu::Instance {
@@ -180,11 +182,18 @@ impl GpuContext {
                 *slot = Some(one_line(&e.to_string()));
             }
         }));
-        let sink = errors.clone();
+        let lost: Arc<Mutex<Option<String>>> = Arc::default();
+        let sink = lost.clone();
         device.set_device_lost_callback(move |reason, message| {
             let mut slot = sink.lock().unwrap_or_else(|p| p.into_inner());
             if slot.is_none() {
-                *slot = Some(format!("device lost ({reason:?}): {}", one_line(&message)));
+                let detail = one_line(&message);
+                let detail = if detail.is_empty() {
+                    String::new()
+                } else {
+                    format!(": {detail}")
+                };
+                *slot = Some(format!("the GPU device was lost ({reason:?}){detail}"));
             }
         });
         Ok(GpuContext {
@@ -194,6 +203,7 @@ impl GpuContext {
             info,
             timestamps,
             errors,
+            lost,
         })
     }
 
@@ -205,8 +215,11 @@ impl GpuContext {
         self.check()
     }
 
-    /// The first uncaptured device error, if one happened.
+    /// The loss of the device, else the first uncaptured device error, if one happened.
     pub fn check(&self) -> Result<(), GpuError> {
+        if let Some(e) = self.lost.lock().unwrap_or_else(|p| p.into_inner()).as_ref() {
+            return Err(GpuError::Device(e.clone()));
+        }
         let slot = self.errors.lock().unwrap_or_else(|p| p.into_inner());
         match slot.as_ref() {
             Some(e) => Err(GpuError::Device(e.clone())),
@@ -265,9 +278,10 @@ impl GpuContext {
             let _ = tx.send(r);
         });
         self.finish()?;
-        rx.recv()
-            .map_err(|e| GpuError::Device(e.to_string()))?
-            .map_err(|e| GpuError::Device(e.to_string()))?;
+        let mapped = rx.recv().map_err(|e| GpuError::Device(e.to_string()))?;
+        // A lost device fails the mapping too: say why.
+        self.check()?;
+        mapped.map_err(|e| GpuError::Device(e.to_string()))?;
         let data = slice
             .get_mapped_range()
             .map_err(|e| GpuError::Device(e.to_string()))?;

@@ -353,3 +353,41 @@ fn image_sizes_of_zero_or_beyond_the_adapter_are_clear_errors() {
     assert_one_error_line(&huge, &["200000x200000", "max_storage_buffer_binding_size"]);
     assert!(!std::path::Path::new("/tmp/igi-huge.png").exists());
 }
+
+#[test]
+fn output_where_no_file_can_be_created() {
+    // /proc takes no new files, even for root (who bypasses permission bits): the case of
+    // an output directory without write permission.
+    let out = igi(&[
+        "render",
+        "--builtin",
+        "cornell-box",
+        "--width",
+        "16",
+        "--height",
+        "16",
+        "-o",
+        "/proc/igi-test.png",
+    ]);
+    if skipped_for_no_adapter(&out) {
+        return;
+    }
+    assert_one_error_line(&out, &["/proc/igi-test.png"]);
+}
+
+#[test]
+fn a_device_or_pipe_as_mesh_is_refused_not_read_forever() {
+    let d = temp_dir("device");
+    let p = write(
+        &d,
+        "scene.toml",
+        &format!("{CAMERA}[[mesh]]\npath = \"/dev/zero\"\n{LIGHT}"),
+    );
+    let out = igi(&[
+        "render",
+        p.to_str().unwrap(),
+        "-o",
+        d.join("x.png").to_str().unwrap(),
+    ]);
+    assert_one_error_line(&out, &["/dev/zero", "not a regular file"]);
+}

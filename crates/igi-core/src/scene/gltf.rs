@@ -109,7 +109,7 @@ pub fn pbr_to_material(base: Vec3, metallic: f32, roughness: f32) -> (Vec3, Vec3
 
 /// Reads the glTF file at `path` (see [`load_gltf_bytes`]).
 pub fn load_gltf(path: &Path) -> Result<GltfMesh, SceneError> {
-    let bytes = std::fs::read(path).map_err(|source| SceneError::Read {
+    let bytes = super::loader::read_regular_file(path).map_err(|source| SceneError::Read {
         what: "mesh",
         path: path.to_path_buf(),
         context: None,
@@ -540,7 +540,7 @@ impl Reader {
                     let p = self
                         .resolve_uri(uri)
                         .map_err(|m| parse(&self.file, format!("buffer {i}: {m}")))?;
-                    let data = std::fs::read(&p).map_err(|source| SceneError::Read {
+                    let data = super::loader::read_regular_file(&p).map_err(|source| SceneError::Read {
                         what: "glTF buffer",
                         path: p.clone(),
                         context: Some(format!("buffer {i} of {}", self.file)),

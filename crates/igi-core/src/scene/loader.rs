@@ -361,12 +361,25 @@ impl TomlFile<'_> {
 // Entry points
 // ---------------------------------------------------------------------------------------
 
+/// Reads a whole file, refusing anything but a regular file: a device (`/dev/zero`) would
+/// be read forever and a FIFO would block, so bad input could hang the loader.
+pub fn read_regular_file(path: &Path) -> io::Result<Vec<u8>> {
+    let meta = std::fs::metadata(path)?;
+    if !meta.is_file() {
+        return Err(io::Error::new(
+            io::ErrorKind::InvalidInput,
+            "not a regular file (a directory, device or pipe)",
+        ));
+    }
+    std::fs::read(path)
+}
+
 /// Loads the scene file at `path` and the meshes it names (paths relative to the file).
 ///
 /// [`Scene::source`] is `path` as given; [`Scene::files`] lists the TOML file, then each
 /// mesh and material library read.
 pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
-    let bytes = std::fs::read(path).map_err(|source| SceneError::Read {
+    let bytes = read_regular_file(path).map_err(|source| SceneError::Read {
         what: "scene file",
         path: path.to_path_buf(),
         context: None,
@@ -423,7 +436,7 @@ pub fn load_scene_str(toml_text: &str, base_dir: &Path, name: &str) -> Result<Sc
             return Err(tf.invalid(mesh.path.span(), "mesh path is empty"));
         }
         let obj_path = base_dir.join(rel);
-        let bytes = std::fs::read(&obj_path).map_err(|source| SceneError::Read {
+        let bytes = read_regular_file(&obj_path).map_err(|source| SceneError::Read {
             what: "mesh",
             path: obj_path.clone(),
             context: Some(format!("referenced by {name}")),
@@ -1285,7 +1298,7 @@ fn load_obj(
         if mtl.read.contains(&lib_path) {
             continue;
         }
-        match std::fs::read(&lib_path) {
+        match read_regular_file(&lib_path) {
             Ok(b) => {
                 read_mtl(&b, &lib_path, mtl)?;
                 mtl.read.insert(lib_path.clone());
