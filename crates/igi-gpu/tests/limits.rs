@@ -41,10 +41,9 @@ fn lost_device_is_an_error_not_a_hang() {
     };
     renderer.render(&ctx, &settings).unwrap();
     ctx.device.destroy();
-    let result = renderer.render(&ctx, &settings);
-    let e = result
-        .err()
-        .expect("a frame on a destroyed device fails")
+    let e = renderer
+        .render(&ctx, &settings)
+        .expect_err("a frame on a destroyed device fails")
         .to_string();
     eprintln!("after destroy: {e}");
     assert_eq!(e.lines().count(), 1, "{e}");
