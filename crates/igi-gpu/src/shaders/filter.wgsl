@@ -88,63 +88,91 @@ fn range_weight(p: u32, q: u32) -> f32 {
     return w;
 }
 
-@compute @workgroup_size(8, 8)
-fn upsample(@builtin(global_invocation_id) gid: vec3<u32>) {
+// What a full-resolution pixel gathers from low-resolution samples: the weighted sum,
+// and the nearest surface sample as the fallback where every weight is zero (a thin
+// feature between samples, every neighbour facing away).
+struct Gathered {
+    sum: vec3<f32>,
+    weight: f32,
+    nearest: vec3<f32>,
+    nearest_d2: f32,
+}
+
+fn new_gathered() -> Gathered {
+    return Gathered(vec3<f32>(0.0), 0.0, vec3<f32>(0.0), 1e30);
+}
+
+// Add low-resolution sample (x, y), inside the image, with weight w, at squared
+// distance d2 (low-resolution pixels) from the pixel being filtered.
+fn gather_sample(g: ptr<function, Gathered>, x: i32, y: i32, w: f32, d2: f32) {
+    let q = representative_pixel(u32(x), u32(y));
+    let value = filter_in[u32(y) * params.low_width + u32(x)].xyz;
+    (*g).sum += w * value;
+    (*g).weight += w;
+    if (gbuf_position[q].w > 0.0 && d2 < (*g).nearest_d2) {
+        (*g).nearest_d2 = d2;
+        (*g).nearest = value;
+    }
+}
+
+fn gathered_value(g: Gathered) -> vec3<f32> {
+    if (g.weight > 1e-6) {
+        return g.sum / g.weight;
+    }
+    return g.nearest;
+}
+
+fn inside_low(x: i32, y: i32) -> bool {
+    return x >= 0 && y >= 0 && x < i32(params.low_width) && y < i32(params.low_height);
+}
+
+// The full-resolution pixel of `gid`, or NO_HIT outside the image or where no surface
+// was hit (its E is written as zero here).
+fn surface_pixel(gid: vec3<u32>) -> u32 {
     if (gid.x >= params.width || gid.y >= params.height) {
-        return;
+        return NO_HIT;
     }
     let pixel = gid.y * params.width + gid.x;
     if (gbuf_position[pixel].w <= 0.0) {
         filter_out[pixel] = vec4<f32>(0.0, 0.0, 0.0, 1.0);
+        return NO_HIT;
+    }
+    return pixel;
+}
+
+@compute @workgroup_size(8, 8)
+fn upsample(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let pixel = surface_pixel(gid);
+    if (pixel == NO_HIT) {
         return;
     }
     let u = low_coordinate(gid.x);
     let v = low_coordinate(gid.y);
     let bx = i32(floor(u));
     let by = i32(floor(v));
-    var sum = vec3<f32>(0.0);
-    var weight = 0.0;
-    var nearest = vec3<f32>(0.0);
-    var nearest_d2 = 1e30;
+    var g = new_gathered();
     let inv_two_sigma2 = 0.5 / (params.upsample_sigma * params.upsample_sigma);
     for (var j = -1; j <= 2; j += 1) {
         for (var i = -1; i <= 2; i += 1) {
             let x = bx + i;
             let y = by + j;
-            if (x < 0 || y < 0 || x >= i32(params.low_width) || y >= i32(params.low_height)) {
+            if (!inside_low(x, y)) {
                 continue;
             }
-            let q = representative_pixel(u32(x), u32(y));
             let dx = f32(x) - u;
             let dy = f32(y) - v;
             let d2 = dx * dx + dy * dy;
-            let value = filter_in[u32(y) * params.low_width + u32(x)].xyz;
-            let w = exp(-d2 * inv_two_sigma2) * range_weight(pixel, q);
-            sum += w * value;
-            weight += w;
-            if (gbuf_position[q].w > 0.0 && d2 < nearest_d2) {
-                nearest_d2 = d2;
-                nearest = value;
-            }
+            let w = exp(-d2 * inv_two_sigma2) * range_weight(pixel, representative_pixel(u32(x), u32(y)));
+            gather_sample(&g, x, y, w, d2);
         }
     }
-    // Where every neighbour faces away (a thin feature between samples), the nearest
-    // surface sample is the best guess left.
-    var e = nearest;
-    if (weight > 1e-6) {
-        e = sum / weight;
-    }
-    filter_out[pixel] = vec4<f32>(e, 1.0);
+    filter_out[pixel] = vec4<f32>(gathered_value(g), 1.0);
 }
 
 @compute @workgroup_size(8, 8)
 fn fused(@builtin(global_invocation_id) gid: vec3<u32>) {
-    if (gid.x >= params.width || gid.y >= params.height) {
-        return;
-    }
-    let pixel = gid.y * params.width + gid.x;
-    if (gbuf_position[pixel].w <= 0.0) {
-        filter_out[pixel] = vec4<f32>(0.0, 0.0, 0.0, 1.0);
+    let pixel = surface_pixel(gid);
+    if (pixel == NO_HIT) {
         return;
     }
     let u = low_coordinate(gid.x);
@@ -153,45 +181,30 @@ fn fused(@builtin(global_invocation_id) gid: vec3<u32>) {
     let by = i32(floor(v));
     let fx = u - f32(bx);
     let fy = v - f32(by);
-    var sum = vec3<f32>(0.0);
-    var weight = 0.0;
-    var nearest = vec3<f32>(0.0);
-    var nearest_d2 = 1e30;
+    var g = new_gathered();
     for (var cj = 0; cj <= 1; cj += 1) {
         for (var ci = 0; ci <= 1; ci += 1) {
             let bilinear = select(1.0 - fx, fx, ci == 1) * select(1.0 - fy, fy, cj == 1);
-            let cx = bx + ci;
-            let cy = by + cj;
-            let x0 = cx - i32(params.interleave_n / 2u);
-            let y0 = cy - i32(params.interleave_m / 2u);
+            let x0 = bx + ci - i32(params.interleave_n / 2u);
+            let y0 = by + cj - i32(params.interleave_m / 2u);
             for (var j = 0; j < i32(params.interleave_m); j += 1) {
                 for (var i = 0; i < i32(params.interleave_n); i += 1) {
                     let x = x0 + i;
                     let y = y0 + j;
-                    if (x < 0 || y < 0 || x >= i32(params.low_width) || y >= i32(params.low_height)) {
+                    if (!inside_low(x, y)) {
                         continue;
                     }
                     let q = representative_pixel(u32(x), u32(y));
-                    let value = filter_in[u32(y) * params.low_width + u32(x)].xyz;
+                    var w = 0.0;
                     if (continuous(pixel, q)) {
-                        let w = bilinear * pow(max(dot(gbuf_normal[pixel].xyz, gbuf_normal[q].xyz), 0.0), params.normal_power);
-                        sum += w * value;
-                        weight += w;
+                        w = bilinear * pow(max(dot(gbuf_normal[pixel].xyz, gbuf_normal[q].xyz), 0.0), params.normal_power);
                     }
                     let dx = f32(x) - u;
                     let dy = f32(y) - v;
-                    let d2 = dx * dx + dy * dy;
-                    if (gbuf_position[q].w > 0.0 && d2 < nearest_d2) {
-                        nearest_d2 = d2;
-                        nearest = value;
-                    }
+                    gather_sample(&g, x, y, w, dx * dx + dy * dy);
                 }
             }
         }
     }
-    var e = nearest;
-    if (weight > 1e-6) {
-        e = sum / weight;
-    }
-    filter_out[pixel] = vec4<f32>(e, 1.0);
+    filter_out[pixel] = vec4<f32>(gathered_value(g), 1.0);
 }
