@@ -147,20 +147,23 @@ pub fn linear_to_srgb(v: f32) -> f32 {
     }
 }
 
+/// Error unless `a` and `b` have the same size (every comparison of two images needs it).
+pub fn same_size(a: &Image, b: &Image) -> Result<(), ImageError> {
+    if a.width != b.width || a.height != b.height {
+        return Err(ImageError::SizeMismatch(
+            a.width, a.height, b.width, b.height,
+        ));
+    }
+    Ok(())
+}
+
 /// Regulariser of [`rel_mse`]: keeps dark pixels from dominating (the usual 0.01).
 pub const REL_MSE_EPSILON: f64 = 0.01;
 
 /// Relative mean squared error of `image` against `reference` on linear radiance:
 /// mean over pixels and channels of (x - r)^2 / (r^2 + 0.01).
 pub fn rel_mse(image: &Image, reference: &Image) -> Result<f64, ImageError> {
-    if image.width != reference.width || image.height != reference.height {
-        return Err(ImageError::SizeMismatch(
-            image.width,
-            image.height,
-            reference.width,
-            reference.height,
-        ));
-    }
+    same_size(image, reference)?;
     let mut sum = 0.0f64;
     for (p, r) in image.data.iter().zip(&reference.data) {
         for c in 0..3 {

@@ -61,14 +61,7 @@ fn flip_impl(
     exposure: f32,
     keep_map: bool,
 ) -> Result<FlipResult, ImageError> {
-    if test.width != reference.width || test.height != reference.height {
-        return Err(ImageError::SizeMismatch(
-            test.width,
-            test.height,
-            reference.width,
-            reference.height,
-        ));
-    }
+    crate::image::same_size(test, reference)?;
     let (width, height) = (test.width, test.height);
     let n = width as usize * height as usize;
     if test.data.len() != n || reference.data.len() != n {

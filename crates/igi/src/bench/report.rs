@@ -654,18 +654,22 @@ fn draw_legend<DB: DrawingBackend>(
     Ok(())
 }
 
-fn draw_stages<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, sc: &SceneRuns) -> DrawResult {
+/// A white chart with `title` on top: the areas left for the plot and for the legend.
+type Areas<DB> = (DrawingArea<DB, Shift>, DrawingArea<DB, Shift>);
+fn titled<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    title: String,
+) -> Result<Areas<DB>, String> {
     root.fill(&WHITE).map_err(de)?;
     let (w, _h) = root.dim_in_pixel();
-    let (title, body) = root.split_vertically(44);
-    title
-        .draw(&Text::new(
-            format!("{}: GPU time per stage (medians)", sc.name),
-            (w as i32 / 2, 12),
-            centred(20),
-        ))
+    let (top, body) = root.split_vertically(44);
+    top.draw(&Text::new(title, (w as i32 / 2, 12), centred(20)))
         .map_err(de)?;
-    let (plot, legend) = body.split_horizontally(w - LEGEND_WIDTH);
+    Ok(body.split_horizontally(w - LEGEND_WIDTH))
+}
+
+fn draw_stages<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, sc: &SceneRuns) -> DrawResult {
+    let (plot, legend) = titled(root, format!("{}: GPU time per stage (medians)", sc.name))?;
 
     let bars = bars(sc);
     let top = bars
@@ -823,17 +827,7 @@ fn decades(values: impl Iterator<Item = f64>) -> (f64, f64) {
 
 /// relMSE (log axis) and FLIP (linear axis) against the median frame time.
 fn draw_errors<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, sc: &SceneRuns) -> DrawResult {
-    root.fill(&WHITE).map_err(de)?;
-    let (w, _h) = root.dim_in_pixel();
-    let (title, body) = root.split_vertically(44);
-    title
-        .draw(&Text::new(
-            format!("{}: image error against frame time", sc.name),
-            (w as i32 / 2, 12),
-            centred(20),
-        ))
-        .map_err(de)?;
-    let (plots, legend) = body.split_horizontally(w - LEGEND_WIDTH);
+    let (plots, legend) = titled(root, format!("{}: image error against frame time", sc.name))?;
     let panels = plots.split_evenly((1, 2));
 
     let mut mse: Vec<ErrorPoint> = Vec::new();
