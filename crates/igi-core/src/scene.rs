@@ -11,7 +11,7 @@ pub mod loader;
 use glam::Vec3;
 use std::path::PathBuf;
 
-pub use loader::{load_scene, SceneError};
+pub use loader::{camera_toml, load_scene, parse_camera_toml, SceneError};
 
 /// A pinhole camera, as `[camera]` in the scene file.
 #[derive(Clone, Copy, Debug, PartialEq)]

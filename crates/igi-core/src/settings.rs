@@ -26,6 +26,10 @@ pub enum OutputBuffer {
     Indirect,
     /// E, the incident indirect term without the albedo.
     Irradiance,
+    /// Shading normals of the primary hits as 0.5 + 0.5 n (black where no surface).
+    Normals,
+    /// Distance from the camera to the primary hit over the scene's diagonal.
+    Depth,
 }
 
 /// How interleaved sampling assigns VPL subsets to the pixels of a tile (paper section 4.3

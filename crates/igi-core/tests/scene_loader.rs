@@ -1102,3 +1102,61 @@ fn error_obj_nan_coordinate() {
     let obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv inf 0 0\nusemtl a\nf 1 2 3\n";
     assert!(load_obj("nan-unused", obj, &grey("a")).is_ok());
 }
+
+/// `igi view --camera` prints the camera as a `[camera]` table: it reads back to the very
+/// same camera, through the camera parser and inside a whole scene file.
+#[test]
+fn camera_toml_round_trips() {
+    use igi_core::scene::{camera_toml, parse_camera_toml, Camera};
+    let camera = Camera {
+        eye: glam::Vec3::new(0.1, -2.5e-3, 7.123_456_7),
+        target: glam::Vec3::new(1.0 / 3.0, 2.0, -4.0),
+        up: glam::Vec3::new(0.0, 0.0, 1.0),
+        fov_y_deg: 47.3,
+    };
+    let text = camera_toml(&camera);
+    assert!(text.starts_with("[camera]\n"), "{text}");
+    assert_eq!(parse_camera_toml(&text, "camera").unwrap(), camera);
+    // Bare keys (no table header) too.
+    let bare = text.replacen("[camera]\n", "", 1);
+    assert_eq!(parse_camera_toml(&bare, "camera").unwrap(), camera);
+    let scene = format!(
+        "{text}\n[[point_light]]\nposition = [0.0, 1.0, 0.0]\nintensity = [1.0, 1.0, 1.0]\n"
+    );
+    let test_dir = TestDir::new("camera");
+    let dir = &test_dir.0;
+    std::fs::write(dir.join("tri.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    let scene = format!(
+        "{scene}\n[[mesh]]\npath = \"tri.obj\"\ndefault_material = \"grey\"\n\n{}",
+        grey("grey")
+    );
+    std::fs::write(dir.join("scene.toml"), scene).unwrap();
+    let loaded = igi_core::scene::load_scene(&dir.join("scene.toml")).unwrap();
+    assert_eq!(loaded.camera, camera);
+}
+
+#[test]
+fn camera_toml_errors_name_the_key() {
+    use igi_core::scene::parse_camera_toml;
+    let e = parse_camera_toml(
+        "eye = [0, 0, 0]\ntarget = [0, 0, 0]\nfov_y_deg = 40\n",
+        "--camera",
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("--camera") && e.contains("view direction is undefined"),
+        "{e}"
+    );
+    let e = parse_camera_toml("eye = [0, 0, 0]\ntarget = [0, 0, 1]\n", "--camera")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("fov_y_deg"), "{e}");
+    let e = parse_camera_toml(
+        "[camera]\neye = [0, 0, 0]\ntarget = [0, 0, 1]\nfov_y_deg = 40\nzoom = 2\n",
+        "--camera",
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("zoom"), "{e}");
+}

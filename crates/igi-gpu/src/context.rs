@@ -86,7 +86,11 @@ fn preference(info: &wgpu::AdapterInfo) -> u32 {
 }
 
 fn adapters() -> Vec<wgpu::Adapter> {
-    pollster::block_on(instance().enumerate_adapters(wgpu::Backends::all()))
+    adapters_of(&instance())
+}
+
+fn adapters_of(instance: &wgpu::Instance) -> Vec<wgpu::Adapter> {
+    pollster::block_on(instance.enumerate_adapters(wgpu::Backends::all()))
         .into_iter()
         // A compute-only renderer needs compute shaders and storage buffers: GL ES without
         // them is of no use.
@@ -153,7 +157,32 @@ impl GpuContext {
     pub fn new(choice: &AdapterChoice) -> Result<GpuContext, GpuError> {
         let mut adapters = adapters();
         let index = pick(&adapters, choice)?;
-        let adapter = adapters.swap_remove(index);
+        Self::open(adapters.swap_remove(index))
+    }
+
+    /// [`GpuContext::new`] for a window: the adapter is chosen among those that can present
+    /// to `target` (the viewer's window), and the surface comes with the context.
+    /// `display` is the windowing system's connection (needed by GL, unused by Vulkan).
+    pub fn for_window(
+        choice: &AdapterChoice,
+        target: impl Into<wgpu::SurfaceTarget<'static>>,
+        display: Box<dyn wgpu::wgt::WgpuHasDisplayHandle>,
+    ) -> Result<(GpuContext, wgpu::Surface<'static>), GpuError> {
+        let instance = wgpu::Instance::new(
+            wgpu::InstanceDescriptor::new_with_display_handle_from_env(display),
+        );
+        let surface = instance
+            .create_surface(target)
+            .map_err(|e| GpuError::Device(format!("cannot draw into the window: {e}")))?;
+        let mut adapters: Vec<wgpu::Adapter> = adapters_of(&instance)
+            .into_iter()
+            .filter(|a| a.is_surface_supported(&surface))
+            .collect();
+        let index = pick(&adapters, choice)?;
+        Ok((Self::open(adapters.swap_remove(index))?, surface))
+    }
+
+    fn open(adapter: wgpu::Adapter) -> Result<GpuContext, GpuError> {
         let info = adapter.get_info();
         let timestamps = adapter.features().contains(wgpu::Features::TIMESTAMP_QUERY);
         let mut features = wgpu::Features::empty();

@@ -7,6 +7,7 @@ use crate::context::{GpuContext, GpuError};
 use crate::layout::{FrameParams, Vpl};
 use crate::passes::compose::ComposePass;
 use crate::passes::direct::{DirectBindings, DirectPass};
+use crate::passes::display::DisplayInputs;
 use crate::passes::filter::{Filter, FilterPass};
 use crate::passes::indirect::IndirectPass;
 use crate::passes::mirror::MirrorPass;
@@ -17,7 +18,7 @@ use crate::scene_buffers::SceneBuffers;
 use igi_core::bvh::Bvh;
 use igi_core::image::Image;
 use igi_core::sampling::{halton_base, pilot_base, DigitPermutations};
-use igi_core::scene::{Camera, Scene};
+use igi_core::scene::{Camera, PointLight, Scene};
 use igi_core::settings::{
     Accelerations, FilterMode, GeometryBound, InterleavePattern, OutputBuffer, RenderSettings,
 };
@@ -174,6 +175,75 @@ impl Renderer {
         };
         ctx.check()?;
         Ok(renderer)
+    }
+
+    /// Look through `camera` from the next frame on.
+    pub fn set_camera(&mut self, camera: Camera) {
+        self.camera = camera;
+    }
+
+    /// The camera of the next frame.
+    pub fn camera(&self) -> Camera {
+        self.camera
+    }
+
+    /// Replace the point lights (same number as the scene's: the viewer moves and dims
+    /// them) from the next frame on. VPLs are shot again every frame, so indirect light
+    /// follows at once; the path count is measured again for the new lights.
+    pub fn set_lights(&mut self, ctx: &GpuContext, lights: &[PointLight]) -> Result<(), GpuError> {
+        if lights.len() as u32 != self.scene.light_count {
+            return Err(GpuError::Limit(format!(
+                "{} lights given, the scene on the GPU has {}",
+                lights.len(),
+                self.scene.light_count
+            )));
+        }
+        let gpu = crate::scene_buffers::gpu_lights(lights);
+        ctx.queue
+            .write_buffer(&self.scene.lights, 0, bytemuck::cast_slice(&gpu));
+        self.light_power_sum = lights.iter().map(|l| l.power().element_sum()).sum();
+        self.total_power = lights
+            .iter()
+            .map(|l| l.power())
+            .sum::<glam::Vec3>()
+            .to_array();
+        self.path_cache = None;
+        Ok(())
+    }
+
+    /// What the viewer's display pass reads: the colour buffer of the last frame and its
+    /// VPLs (`None` before the first frame).
+    pub fn display_inputs(&self) -> Option<DisplayInputs<'_>> {
+        let (img, vb) = (self.images.as_ref()?, self.vpl_buffers.as_ref()?);
+        Some(DisplayInputs {
+            params: &self.params,
+            color: &img.color,
+            vpls: &vb.vpls,
+            vpl_header: &self.vpl_header,
+            width: img.width,
+            height: img.height,
+            vpl_slots: vb.slots.min(u32::MAX as u64) as u32,
+        })
+    }
+
+    /// The colour buffer of the last submitted frame (waits for it).
+    pub fn read_image(&self, ctx: &GpuContext) -> Result<Image, GpuError> {
+        let Some(images) = self.images.as_ref() else {
+            return Err(GpuError::Device("no frame rendered yet".into()));
+        };
+        let rgba: Vec<[f32; 4]> = ctx.read_buffer(&images.color)?;
+        let pixels = images.width as usize * images.height as usize;
+        Ok(Image::from_rgba(
+            images.width,
+            images.height,
+            &rgba[..pixels],
+        ))
+    }
+
+    /// VPLs stored by the last submitted frame (waits for it).
+    pub fn vpl_count(&self, ctx: &GpuContext) -> Result<u32, GpuError> {
+        let header: Vec<u32> = ctx.read_buffer(&self.vpl_header)?;
+        Ok(header[0])
     }
 
     /// Bytes held on the GPU by the scene.
@@ -370,6 +440,8 @@ impl Renderer {
                 OutputBuffer::Direct => 1,
                 OutputBuffer::Indirect => 2,
                 OutputBuffer::Irradiance => 3,
+                OutputBuffer::Normals => 4,
+                OutputBuffer::Depth => 5,
             },
             light_power_sum: self.light_power_sum,
             low_width: low.0,
@@ -391,6 +463,8 @@ impl Renderer {
             jitter_x: jitter.0,
             jitter_y: jitter.1,
             count_rays: 0,
+            depth_scale: 1.0 / self.diagonal.max(f32::MIN_POSITIVE),
+            _pad: [0; 3],
         }
     }
 
@@ -472,10 +546,8 @@ impl Renderer {
             };
             (names, paths) = self.submit_frame(ctx, &frame, k)?;
         }
-        let images = self.images.as_ref().expect("allocated");
-        let rgba: Vec<[f32; 4]> = ctx.read_buffer(&images.color)?;
-        let pixels = settings.width as usize * settings.height as usize;
-        let header: Vec<u32> = ctx.read_buffer(&self.vpl_header)?;
+        let image = self.read_image(ctx)?;
+        let vpl_count = self.vpl_count(ctx)?;
         let timing = self.profiler.read(ctx, &names)?;
         ctx.check()?;
         let (stages, frame_ms) = match timing {
@@ -483,8 +555,8 @@ impl Renderer {
             None => (vec![], None),
         };
         Ok(FrameOutput {
-            image: Image::from_rgba(settings.width, settings.height, &rgba[..pixels]),
-            vpl_count: header[0],
+            image,
+            vpl_count,
             path_count: paths,
             stages,
             frame_ms,
@@ -803,7 +875,15 @@ impl Renderer {
 
         let compose_bind = self.compose.bind(
             device,
-            &[&self.params, &img.direct, &img.albedo, e, &img.color],
+            &[
+                &self.params,
+                &img.direct,
+                &img.albedo,
+                e,
+                &img.color,
+                &img.position,
+                &img.normal,
+            ],
         );
         let i = stage("compose");
         dispatch(

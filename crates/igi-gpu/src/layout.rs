@@ -70,7 +70,7 @@ pub struct Vpl {
     pub _pad1: f32,
 }
 
-/// Parameters of one frame (uniform buffer, 176 bytes).
+/// Parameters of one frame (uniform buffer, 192 bytes).
 /// | offset | field | |
 /// |---|---|---|
 /// | 0 | cam_eye: vec3f | camera position |
@@ -89,7 +89,7 @@ pub struct Vpl {
 /// | 92 | geometry_bound: u32 | 0 smoothstep, 1 clamp |
 /// | 96 | mirror_depth: u32 | Whitted depth limit |
 /// | 100 | halton_base: u32 | first Halton index of this frame's paths |
-/// | 104 | output: u32 | 0 final, 1 direct, 2 indirect, 3 irradiance |
+/// | 104 | output: u32 | 0 final, 1 direct, 2 indirect, 3 irradiance, 4 normals, 5 depth |
 /// | 108 | light_power_sum: f32 | sum over lights of (r + g + b) of the power: light choice |
 /// | 112 | low_width: u32 | width of the indirect term (width / downsample, rounded up) |
 /// | 116 | low_height: u32 | |
@@ -107,6 +107,8 @@ pub struct Vpl {
 /// | 164 | jitter_x: f32 | primary ray offset within the pixel, in pixels |
 /// | 168 | jitter_y: f32 | |
 /// | 172 | count_rays: u32 | 1 in a frame that counts its rays (scene binding 5) |
+/// | 176 | depth_scale: f32 | 1 / scene diagonal: the depth buffer's unit |
+/// | 180 | _pad: [u32; 3] | |
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct FrameParams {
@@ -144,4 +146,28 @@ pub struct FrameParams {
     pub jitter_x: f32,
     pub jitter_y: f32,
     pub count_rays: u32,
+    pub depth_scale: f32,
+    pub _pad: [u32; 3],
+}
+
+/// Parameters of the viewer's display pass (uniform buffer, 48 bytes; `shaders/display.wgsl`).
+/// | offset | field | |
+/// |---|---|---|
+/// | 0 | viewport: vec4f | the image's rectangle in the target: x, y, width, height (pixels) |
+/// | 16 | image_width: u32 | |
+/// | 20 | image_height: u32 | |
+/// | 24 | exposure: f32 | multiplier before clamping and sRGB encoding |
+/// | 28 | encode_srgb: u32 | 1 when the shader encodes sRGB (a non-sRGB target format) |
+/// | 32 | dot_radius: f32 | half side of a VPL dot, in target pixels |
+/// | 36 | _pad: [u32; 3] | |
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct DisplayParams {
+    pub viewport: [f32; 4],
+    pub image_width: u32,
+    pub image_height: u32,
+    pub exposure: f32,
+    pub encode_srgb: u32,
+    pub dot_radius: f32,
+    pub _pad: [u32; 3],
 }

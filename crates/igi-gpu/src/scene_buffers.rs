@@ -11,6 +11,8 @@ pub struct SceneBuffers {
     pub layout: wgpu::BindGroupLayout,
     pub bind_group: wgpu::BindGroup,
     pub light_count: u32,
+    /// The point lights (binding 4), rewritten when the viewer moves a light.
+    pub lights: wgpu::Buffer,
     /// The ray counters of scene.wgsl (8 x u32).
     pub ray_counters: wgpu::Buffer,
     /// Bytes held on the GPU by the scene.
@@ -63,6 +65,19 @@ pub fn storage_buffer(
         }))
 }
 
+/// The point lights as the GPU reads them.
+pub fn gpu_lights(lights: &[igi_core::scene::PointLight]) -> Vec<GpuLight> {
+    lights
+        .iter()
+        .map(|l| GpuLight {
+            position: l.position.to_array(),
+            _pad0: 0.0,
+            intensity: l.intensity.to_array(),
+            _pad1: 0.0,
+        })
+        .collect()
+}
+
 impl SceneBuffers {
     pub fn layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
         device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -99,16 +114,7 @@ impl SceneBuffers {
                 _pad1: 0.0,
             })
             .collect();
-        let lights: Vec<GpuLight> = scene
-            .lights
-            .iter()
-            .map(|l| GpuLight {
-                position: l.position.to_array(),
-                _pad0: 0.0,
-                intensity: l.intensity.to_array(),
-                _pad1: 0.0,
-            })
-            .collect();
+        let lights = gpu_lights(&scene.lights);
         let buffers = [
             storage_buffer(ctx, "BVH nodes", bytemuck::cast_slice(&bvh.nodes))?,
             storage_buffer(
@@ -137,10 +143,12 @@ impl SceneBuffers {
             layout: &layout,
             entries: &entries,
         });
+        let [_, _, _, _, lights_buffer] = buffers;
         Ok(SceneBuffers {
             layout,
             bind_group,
             light_count: lights.len() as u32,
+            lights: lights_buffer,
             ray_counters,
             bytes,
         })

@@ -2,7 +2,9 @@
 //! in front of a user), and every host/GPU struct has the size and field offsets that
 //! the WGSL declares.
 
-use igi_gpu::layout::{BvhNode, FrameParams, GpuLight, GpuMaterial, TriShading, Vpl};
+use igi_gpu::layout::{
+    BvhNode, DisplayParams, FrameParams, GpuLight, GpuMaterial, TriShading, Vpl,
+};
 use std::mem::{offset_of, size_of};
 
 fn parse_and_validate(name: &str, src: &str) -> naga::Module {
@@ -103,7 +105,46 @@ fn host_structs_match_wgsl() {
             mirror_depth,
             halton_base,
             output,
-            light_power_sum
+            light_power_sum,
+            low_width,
+            low_height,
+            downsample,
+            interleave_n,
+            interleave_m,
+            pattern,
+            seed,
+            accumulate_index,
+            upsample_sigma,
+            normal_power,
+            upsample_depth,
+            depth_threshold,
+            normal_threshold,
+            jitter_x,
+            jitter_y,
+            count_rays,
+            depth_scale
+        ]
+    );
+}
+
+#[test]
+fn display_params_match_wgsl() {
+    let (name, src) = igi_gpu::shader::all_shaders()
+        .into_iter()
+        .find(|(n, _)| *n == "display")
+        .expect("display shader");
+    let module = parse_and_validate(name, &src);
+    check_layout!(
+        &module,
+        "DisplayParams",
+        DisplayParams,
+        [
+            viewport,
+            image_width,
+            image_height,
+            exposure,
+            encode_srgb,
+            dot_radius
         ]
     );
 }

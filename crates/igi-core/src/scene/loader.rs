@@ -393,6 +393,48 @@ pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
     Ok(scene)
 }
 
+/// The camera of a `[camera]` table (or of its bare keys) in TOML text, validated as in a
+/// scene file: what `igi view --camera` accepts and [`camera_toml`] writes.
+pub fn parse_camera_toml(toml_text: &str, name: &str) -> Result<Camera, SceneError> {
+    #[derive(Deserialize)]
+    #[serde(deny_unknown_fields)]
+    struct Wrapped {
+        camera: Spanned<CameraDesc>,
+    }
+    let tf = TomlFile {
+        text: toml_text,
+        name,
+    };
+    let parse_error = |e: toml::de::Error| {
+        let at = e.span().map_or(Location::file(name), |span| tf.at(span));
+        SceneError::parse(at, toml_message(&e))
+    };
+    let has_table = toml_text.lines().any(|l| l.trim() == "[camera]");
+    let desc = if has_table {
+        toml::from_str::<Wrapped>(toml_text)
+            .map_err(parse_error)?
+            .camera
+    } else {
+        let bare: CameraDesc = toml::from_str(toml_text).map_err(parse_error)?;
+        Spanned::new(0..toml_text.len(), bare)
+    };
+    camera(&tf, &desc)
+}
+
+/// `camera` as the `[camera]` table of a scene file (round-trips through
+/// [`parse_camera_toml`] and [`load_scene`]).
+pub fn camera_toml(camera: &Camera) -> String {
+    // `{:?}` of an f32 prints the shortest decimal that reads back to the same value.
+    let v = |v: Vec3| format!("[{:?}, {:?}, {:?}]", v.x, v.y, v.z);
+    format!(
+        "[camera]\neye = {}\ntarget = {}\nup = {}\nfov_y_deg = {:?}\n",
+        v(camera.eye),
+        v(camera.target),
+        v(camera.up),
+        camera.fov_y_deg
+    )
+}
+
 /// Loads a scene from TOML text held in memory. Mesh paths are relative to `base_dir`;
 /// `name` stands for the TOML file in messages and becomes [`Scene::source`].
 /// [`Scene::files`] lists the meshes and material libraries read.

@@ -11,15 +11,19 @@ pub struct ComposePass {
 
 impl ComposePass {
     pub fn new(device: &wgpu::Device, scene_layout: &wgpu::BindGroupLayout) -> ComposePass {
-        // params, direct, albedo, irradiance, color
-        let layout = pass_layout(device, "compose", &[UNIFORM, READ, READ, READ, WRITE]);
+        // params, direct, albedo, irradiance, color, G-buffer position and normal
+        let layout = pass_layout(
+            device,
+            "compose",
+            &[UNIFORM, READ, READ, READ, WRITE, READ, READ],
+        );
         ComposePass {
             pipeline: pipeline(device, "compose", "main", &[scene_layout, &layout]),
             layout,
         }
     }
 
-    pub fn bind(&self, device: &wgpu::Device, buffers: &[&wgpu::Buffer; 5]) -> wgpu::BindGroup {
+    pub fn bind(&self, device: &wgpu::Device, buffers: &[&wgpu::Buffer; 7]) -> wgpu::BindGroup {
         bind(device, "compose", &self.layout, buffers)
     }
 

@@ -4,6 +4,7 @@
 
 pub mod compose;
 pub mod direct;
+pub mod display;
 pub mod filter;
 pub mod indirect;
 pub mod mirror;
@@ -55,6 +56,11 @@ pub const SOURCES: &[PassSource] = &[
     PassSource {
         name: "compose",
         wgsl: include_str!("../shaders/compose.wgsl"),
+        gathers: false,
+    },
+    PassSource {
+        name: "display",
+        wgsl: include_str!("../shaders/display.wgsl"),
         gathers: false,
     },
 ];

@@ -1,12 +1,15 @@
 // compose.wgsl: the final image (paper section 4, last stage):
 // L = direct_specular + (rho_d(x) / pi) E(x), linear radiance; tone mapping happens only
-// when an image is written. `params.output` picks another buffer for inspection.
+// when an image is written. `params.output` picks another buffer for inspection (the
+// viewer's buffer choice): direct, indirect, E, normals or depth of the primary hits.
 // `irradiance_in` is E at full resolution: the indirect pass's output, or the last filter's.
 
 @group(1) @binding(1) var<storage, read> direct_in: array<vec4<f32>>;
 @group(1) @binding(2) var<storage, read> gbuf_albedo: array<vec4<f32>>;
 @group(1) @binding(3) var<storage, read> irradiance_in: array<vec4<f32>>;
 @group(1) @binding(4) var<storage, read_write> color_out: array<vec4<f32>>;
+@group(1) @binding(5) var<storage, read> gbuf_position: array<vec4<f32>>;
+@group(1) @binding(6) var<storage, read> gbuf_normal: array<vec4<f32>>;
 
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
@@ -18,10 +21,17 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let e = irradiance_in[pixel].xyz;
     let indirect = gbuf_albedo[pixel].xyz / PI * e;
     var c = direct + indirect;
+    // position.w > 0 where the primary ray hit a surface.
+    let hit = gbuf_position[pixel].w > 0.0;
     switch params.output {
         case 1u: { c = direct; }
         case 2u: { c = indirect; }
         case 3u: { c = e; }
+        case 4u: { c = select(vec3<f32>(0.0), 0.5 + 0.5 * gbuf_normal[pixel].xyz, hit); }
+        case 5u: {
+            let d = distance(gbuf_position[pixel].xyz, params.cam_eye) * params.depth_scale;
+            c = select(vec3<f32>(0.0), vec3<f32>(d), hit);
+        }
         default: {}
     }
     // Accumulation (--accumulate K): a running mean over frames with fresh VPL sets.

@@ -26,6 +26,7 @@ struct FrameParams {
     interleave_m: u32, pattern: u32, seed: u32, accumulate_index: u32,
     upsample_sigma: f32, normal_power: f32, upsample_depth: u32, depth_threshold: f32,
     normal_threshold: f32, jitter_x: f32, jitter_y: f32, count_rays: u32,
+    depth_scale: f32, _pad0: u32, _pad1: u32, _pad2: u32,
 }
 
 // A virtual point light: 64 bytes, see layout.rs.
