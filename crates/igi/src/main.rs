@@ -1,6 +1,6 @@
 //! `igi`: Instant Global Illumination on the GPU (Marques and Santos), from the command line.
-//! `igi render` renders a scene file or a built-in scene to PNG/EXR; `igi info` lists the
-//! GPU adapters.
+//! `igi render` renders a scene file or a built-in scene to PNG/EXR; `igi view` opens the
+//! interactive viewer; `igi bench` measures; `igi info` lists the GPU adapters.
 
 use anyhow::{bail, Context, Result};
 use clap::{Args, Parser, Subcommand, ValueEnum};
@@ -29,6 +29,9 @@ struct Cli {
 enum Command {
     /// Render a scene to an sRGB PNG (and optionally linear OpenEXR).
     Render(RenderArgs),
+    /// Open a window: fly through the scene, change any option and watch the GPU times;
+    /// a still view converges (frames with fresh VPL sets are averaged).
+    View(ViewArgs),
     /// List the GPU adapters wgpu sees and the one igi would pick.
     Info,
     /// Measure like the paper: GPU time per stage, fps, rays and image error for every
@@ -174,6 +177,10 @@ enum BufferArg {
     Indirect,
     /// The incident indirect term E, without albedo.
     Irradiance,
+    /// G-buffer shading normals as 0.5 + 0.5 n.
+    Normals,
+    /// G-buffer distance from the camera over the scene's diagonal.
+    Depth,
 }
 
 /// Where the scene comes from: a file or a built-in.
@@ -378,6 +385,137 @@ struct RenderArgs {
     timings: bool,
 }
 
+#[derive(Args)]
+struct ViewArgs {
+    #[command(flatten)]
+    scene: SceneArgs,
+    /// Image size and the options of the frame; with --width/--height the image keeps that
+    /// size (letterboxed in the window), otherwise it follows the window.
+    #[command(flatten)]
+    frame: FrameArgs,
+    /// Multiplier applied before tone mapping (the panel changes it).
+    #[arg(long, default_value_t = 1.0)]
+    exposure: f32,
+    /// Which buffer to show first.
+    #[arg(long, value_enum, default_value = "final")]
+    buffer: BufferArg,
+    /// Start from this camera: a TOML file with a [camera] table, or the TOML itself
+    /// (as the C key prints it), instead of the scene's.
+    #[arg(long, value_name = "FILE|TOML")]
+    camera: Option<String>,
+    /// Render N frames, then exit (with --screenshot: save it first).
+    #[arg(long, value_name = "N")]
+    frames: Option<u32>,
+    /// Where screenshots go: PNG at the panel's exposure, and the linear frame as EXR
+    /// beside it (default: igi-screenshot-N.png in the working directory).
+    #[arg(long, value_name = "PNG")]
+    screenshot: Option<PathBuf>,
+    /// Still frames averaged at most.
+    #[arg(long, default_value_t = 256)]
+    max_accumulate: u32,
+    /// Render at 1/S of the window's resolution (faster on slow adapters).
+    #[arg(long, value_name = "S", default_value_t = 1)]
+    scale: u32,
+    /// Draw the VPLs as dots.
+    #[arg(long)]
+    vpl_dots: bool,
+    /// Initial window size in pixels, WxH.
+    #[arg(long, value_name = "WxH", default_value = "1280x720", value_parser = parse_size)]
+    window: (u32, u32),
+}
+
+fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let bad = || format!("'{s}' is not WxH (e.g. 1280x720)");
+    let (w, h) = s.split_once(['x', 'X']).ok_or_else(bad)?;
+    let (w, h) = (
+        w.trim().parse::<u32>().map_err(|_| bad())?,
+        h.trim().parse::<u32>().map_err(|_| bad())?,
+    );
+    if w == 0 || h == 0 || w > 16384 || h > 16384 {
+        return Err(format!("window {w}x{h}: sides between 1 and 16384"));
+    }
+    Ok((w, h))
+}
+
+fn output_buffer(b: BufferArg) -> OutputBuffer {
+    match b {
+        BufferArg::Final => OutputBuffer::Final,
+        BufferArg::Direct => OutputBuffer::Direct,
+        BufferArg::Indirect => OutputBuffer::Indirect,
+        BufferArg::Irradiance => OutputBuffer::Irradiance,
+        BufferArg::Normals => OutputBuffer::Normals,
+        BufferArg::Depth => OutputBuffer::Depth,
+    }
+}
+
+fn view(args: &ViewArgs) -> Result<()> {
+    if !(args.exposure.is_finite() && args.exposure > 0.0) {
+        bail!(
+            "--exposure must be a positive number, got {}",
+            args.exposure
+        );
+    }
+    if args.frames == Some(0) {
+        bail!("--frames must be at least 1");
+    }
+    if args.scale == 0 || args.scale > 64 {
+        bail!("--scale must be between 1 and 64, got {}", args.scale);
+    }
+    if args.max_accumulate == 0 {
+        bail!("--max-accumulate must be at least 1");
+    }
+    if let Some(dir) = args.screenshot.as_ref().and_then(|p| p.parent()) {
+        if !dir.as_os_str().is_empty() && !dir.is_dir() {
+            bail!("--screenshot: directory {} does not exist", dir.display());
+        }
+    }
+    let camera = match &args.camera {
+        None => None,
+        Some(text) => {
+            let path = std::path::Path::new(text);
+            let (text, name) = if !text.contains('=') {
+                let bytes = igi_core::scene::loader::read_regular_file(path)
+                    .with_context(|| format!("--camera {}", path.display()))?;
+                let text = String::from_utf8(bytes)
+                    .map_err(|_| anyhow::anyhow!("--camera {}: not UTF-8 text", path.display()))?;
+                (text, path.display().to_string())
+            } else {
+                (text.clone(), "--camera".to_string())
+            };
+            Some(igi_core::scene::parse_camera_toml(&text, &name)?)
+        }
+    };
+    let scene = load(&args.scene)?;
+    let mut settings = settings(&scene, &args.frame)?;
+    settings.exposure = args.exposure;
+    settings.output = output_buffer(args.buffer);
+    let fixed_size = match (args.frame.width, args.frame.height) {
+        (None, None) => None,
+        (w, h) => Some((
+            w.unwrap_or(scene.film.width),
+            h.unwrap_or(scene.film.height),
+        )),
+    };
+    if let Some((w, h)) = fixed_size {
+        if w == 0 || h == 0 {
+            bail!("image size {w}x{h}: both must be at least 1");
+        }
+    }
+    igi::view::run(igi::view::ViewOptions {
+        settings,
+        fixed_size,
+        adapter: AdapterChoice::from_option(args.frame.adapter.as_deref()),
+        camera,
+        frames: args.frames,
+        screenshot: args.screenshot.clone(),
+        max_accumulate: args.max_accumulate.max(args.frame.accel.accumulate),
+        render_scale: args.scale,
+        show_vpls: args.vpl_dots,
+        window: args.window,
+        scene,
+    })
+}
+
 fn load(args: &SceneArgs) -> Result<Scene> {
     match (&args.scene, &args.builtin) {
         (_, Some(name)) => builtin::builtin_scene(name).with_context(|| {
@@ -436,12 +574,7 @@ fn render(args: &RenderArgs) -> Result<()> {
     let load_ms = t.elapsed().as_secs_f64() * 1e3;
     let mut settings = settings(&scene, &args.frame)?;
     settings.exposure = args.exposure;
-    settings.output = match args.buffer {
-        BufferArg::Final => OutputBuffer::Final,
-        BufferArg::Direct => OutputBuffer::Direct,
-        BufferArg::Indirect => OutputBuffer::Indirect,
-        BufferArg::Irradiance => OutputBuffer::Irradiance,
-    };
+    settings.output = output_buffer(args.buffer);
     let t = Instant::now();
     let bvh = Bvh::build(&scene.triangles);
     let bvh_ms = t.elapsed().as_secs_f64() * 1e3;
@@ -642,6 +775,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
         Command::Render(args) => render(args),
+        Command::View(args) => view(args),
         Command::Info => info(),
         Command::Bench(cmd) => match &cmd.sub {
             Some(BenchSub::Rays(r)) => bench_rays(r),
