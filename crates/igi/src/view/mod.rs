@@ -167,6 +167,8 @@ struct Viewer {
     frames_rendered: u32,
     stats: Stats,
     last: Instant,
+    /// The first redraw (for the frame rate `--frames` reports).
+    started: Option<Instant>,
     diagonal: f32,
     /// Asked by a key, done after the next frame.
     screenshot: bool,
@@ -247,6 +249,7 @@ impl Viewer {
             frames_rendered: 0,
             stats,
             last: Instant::now(),
+            started: None,
             diagonal: scene.diagonal(),
             screenshot: false,
             print_camera: false,
@@ -333,6 +336,7 @@ impl Viewer {
     /// the display and the panel drawn into the window. Returns whether to exit.
     fn redraw(&mut self, opts: &ViewOptions) -> Result<bool> {
         let now = Instant::now();
+        self.started.get_or_insert(now);
         let seconds = (now - self.last).as_secs_f32().min(0.25);
         self.last = now;
         let moved = self
@@ -461,6 +465,17 @@ impl Viewer {
         }
         if let Some(n) = opts.frames {
             if self.frames_rendered >= n {
+                let started = self.started.get_or_insert(now);
+                let seconds = started.elapsed().as_secs_f64();
+                eprintln!(
+                    "{n} frames of {width}x{height} in a {}x{} window in {seconds:.2} s: {:.2} fps{}",
+                    self.config.width,
+                    self.config.height,
+                    n as f64 / seconds.max(1e-9),
+                    self.stats
+                        .gpu_ms
+                        .map_or(String::new(), |ms| format!(" (last frame {ms:.3} ms of GPU time)")),
+                );
                 if let Some(path) = &opts.screenshot {
                     eprintln!("{}", self.save(path)?);
                 }
