@@ -4,7 +4,7 @@
 use std::sync::{Arc, Mutex};
 
 /// Errors of the GPU layer, each one line for the user.
-#[derive(Debug, thiserror::Error)]
+#[derive(Clone, Debug, thiserror::Error)]
 pub enum GpuError {
     #[error("no GPU adapter found: install a Vulkan driver (on Debian/Ubuntu the software one: `apt-get install mesa-vulkan-drivers`)")]
     NoAdapter,
@@ -16,6 +16,25 @@ pub enum GpuError {
     Device(String),
     #[error("{0}")]
     Limit(String),
+    /// Memory could not be allocated: `what` was being allocated (GPU memory for what,
+    /// mostly), `bytes` large (where known); `hint` says what needs less.
+    #[error("{}", out_of_memory_message(what, *bytes, hint))]
+    OutOfMemory {
+        what: String,
+        bytes: Option<u64>,
+        hint: &'static str,
+    },
+}
+
+/// What a frame needs less memory with: the hint of most [`GpuError::OutOfMemory`]s.
+pub const SMALLER_FRAME: &str = "a smaller image or fewer VPLs need less";
+
+fn out_of_memory_message(what: &str, bytes: Option<u64>, hint: &str) -> String {
+    let size = match bytes {
+        Some(b) => format!(" ({} MiB)", b.div_ceil(1 << 20)),
+        None => String::new(),
+    };
+    format!("out of memory: could not allocate {what}{size}; {hint}")
 }
 
 /// VPL range of one gathering dispatch on a software adapter (see
@@ -61,9 +80,9 @@ pub struct GpuContext {
     /// Whether GPU timestamp queries (per-stage timings) are available.
     pub timestamps: bool,
     /// The first uncaptured error (validation, out of memory) seen on the device, if any.
-    errors: Arc<Mutex<Option<String>>>,
+    errors: Arc<Mutex<Option<GpuError>>>,
     /// Why the device was lost, if it was: reported before any error it causes.
-    lost: Arc<Mutex<Option<String>>>,
+    lost: Arc<Mutex<Option<GpuError>>>,
 }
 
 fn instance() -> wgpu::Instance {
@@ -203,26 +222,20 @@ impl GpuContext {
                 reason: e.to_string(),
             }
         })?;
-        let errors: Arc<Mutex<Option<String>>> = Arc::default();
+        let errors: Arc<Mutex<Option<GpuError>>> = Arc::default();
         let sink = errors.clone();
         device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
             let mut slot = sink.lock().unwrap_or_else(|p| p.into_inner());
             if slot.is_none() {
-                *slot = Some(one_line(&e.to_string()));
+                *slot = Some(uncaptured(&e));
             }
         }));
-        let lost: Arc<Mutex<Option<String>>> = Arc::default();
+        let lost: Arc<Mutex<Option<GpuError>>> = Arc::default();
         let sink = lost.clone();
         device.set_device_lost_callback(move |reason, message| {
             let mut slot = sink.lock().unwrap_or_else(|p| p.into_inner());
             if slot.is_none() {
-                let detail = one_line(&message);
-                let detail = if detail.is_empty() {
-                    String::new()
-                } else {
-                    format!(": {detail}")
-                };
-                *slot = Some(format!("the GPU device was lost ({reason:?}){detail}"));
+                *slot = Some(lost_device(reason, &message));
             }
         });
         Ok(GpuContext {
@@ -247,12 +260,39 @@ impl GpuContext {
     /// The loss of the device, else the first uncaptured device error, if one happened.
     pub fn check(&self) -> Result<(), GpuError> {
         if let Some(e) = self.lost.lock().unwrap_or_else(|p| p.into_inner()).as_ref() {
-            return Err(GpuError::Device(e.clone()));
+            return Err(e.clone());
         }
         let slot = self.errors.lock().unwrap_or_else(|p| p.into_inner());
         match slot.as_ref() {
-            Some(e) => Err(GpuError::Device(e.clone())),
+            Some(e) => Err(e.clone()),
             None => Ok(()),
+        }
+    }
+
+    /// Create resources with `make`, catching the device's out-of-memory errors: if an
+    /// allocation fails, what `make` made is dropped and the error is
+    /// [`GpuError::OutOfMemory`] naming `what()` and `bytes`. Other errors stay uncaptured
+    /// (see [`GpuContext::check`]).
+    pub fn allocate<T>(
+        &self,
+        what: impl FnOnce() -> String,
+        bytes: u64,
+        hint: &'static str,
+        make: impl FnOnce() -> T,
+    ) -> Result<T, GpuError> {
+        let scope = self.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
+        let made = make();
+        // With wgpu-core the future is ready at once: the scope holds what was caught.
+        match pollster::block_on(scope.pop()) {
+            None => Ok(made),
+            Some(_) => {
+                drop(made);
+                Err(GpuError::OutOfMemory {
+                    what: format!("GPU memory for {}", what()),
+                    bytes: Some(bytes),
+                    hint,
+                })
+            }
         }
     }
 
@@ -288,12 +328,19 @@ impl GpuContext {
     /// Read a storage buffer back to the CPU (through a staging copy).
     pub fn read_buffer<T: bytemuck::Pod>(&self, buffer: &wgpu::Buffer) -> Result<Vec<T>, GpuError> {
         let size = buffer.size();
-        let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("readback"),
+        let staging = self.allocate(
+            || "a staging buffer to read results back".to_string(),
             size,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+            SMALLER_FRAME,
+            || {
+                self.device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("readback"),
+                    size,
+                    usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                    mapped_at_creation: false,
+                })
+            },
+        )?;
         let mut encoder = self
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
@@ -314,13 +361,110 @@ impl GpuContext {
         let data = slice
             .get_mapped_range()
             .map_err(|e| GpuError::Device(e.to_string()))?;
-        let out = bytemuck::cast_slice::<u8, T>(&data).to_vec();
+        // Host memory, which a software adapter shares with its buffers: a failed
+        // allocation is reported like the device's own.
+        let values = bytemuck::cast_slice::<u8, T>(&data);
+        let mut out = Vec::new();
+        out.try_reserve_exact(values.len())
+            .map_err(|_| GpuError::OutOfMemory {
+                what: "host memory for the results read back".to_string(),
+                bytes: Some(size),
+                hint: SMALLER_FRAME,
+            })?;
+        out.extend_from_slice(values);
         drop(data);
         staging.unmap();
         Ok(out)
     }
 }
 
+/// An error no scope caught, for [`GpuContext::check`]: out of memory as such, anything
+/// else as a device error (its message on one line).
+fn uncaptured(e: &wgpu::Error) -> GpuError {
+    match e {
+        wgpu::Error::OutOfMemory { source } => GpuError::OutOfMemory {
+            what: format!("GPU memory ({})", error_chain(source.as_ref())),
+            bytes: None,
+            hint: SMALLER_FRAME,
+        },
+        e => GpuError::Device(one_line(&e.to_string())),
+    }
+}
+
+/// The error of a lost device. wgpu loses the device when memory it cannot do without
+/// (a staging buffer, say) fails to allocate: that loss is reported as out of memory.
+fn lost_device(reason: wgpu::DeviceLostReason, message: &str) -> GpuError {
+    let detail = one_line(message);
+    if detail.to_lowercase().contains("out of memory") {
+        return GpuError::OutOfMemory {
+            what: format!("GPU memory and the device was lost ({detail})"),
+            bytes: None,
+            hint: SMALLER_FRAME,
+        };
+    }
+    let detail = if detail.is_empty() {
+        String::new()
+    } else {
+        format!(": {detail}")
+    };
+    GpuError::Device(format!("the GPU device was lost ({reason:?}){detail}"))
+}
+
+/// An error and its sources, on one line, separated by ": ".
+fn error_chain(e: &(dyn std::error::Error + 'static)) -> String {
+    let mut parts = vec![one_line(&e.to_string())];
+    let mut source = e.source();
+    while let Some(s) = source {
+        parts.push(one_line(&s.to_string()));
+        source = s.source();
+    }
+    parts.dedup();
+    parts.join(": ")
+}
+
 fn one_line(s: &str) -> String {
     s.split_whitespace().collect::<Vec<_>>().join(" ")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn uncaught_out_of_memory_is_reported_as_such() {
+        let e = uncaptured(&wgpu::Error::OutOfMemory {
+            source: "Not enough memory left.".into(),
+        })
+        .to_string();
+        assert_eq!(
+            e,
+            "out of memory: could not allocate GPU memory (Not enough memory left.); a smaller image or fewer VPLs need less"
+        );
+        let e = uncaptured(&wgpu::Error::Validation {
+            source: "x".into(),
+            description: "Buffer is\n invalid".into(),
+        });
+        assert_eq!(e.to_string(), "GPU error: Buffer is invalid");
+    }
+
+    #[test]
+    fn a_device_lost_for_memory_says_out_of_memory() {
+        let e = lost_device(wgpu::DeviceLostReason::Unknown, "Out of memory").to_string();
+        assert!(e.starts_with("out of memory:") && e.contains("lost"), "{e}");
+        let e = lost_device(wgpu::DeviceLostReason::Destroyed, "").to_string();
+        assert_eq!(e, "GPU error: the GPU device was lost (Destroyed)");
+    }
+
+    #[test]
+    fn out_of_memory_names_what_and_how_large() {
+        let e = GpuError::OutOfMemory {
+            what: "GPU memory for the 13 frame buffers of a 4096x4096 image".into(),
+            bytes: Some(13 * 4096 * 4096 * 16),
+            hint: SMALLER_FRAME,
+        };
+        assert_eq!(
+            e.to_string(),
+            "out of memory: could not allocate GPU memory for the 13 frame buffers of a 4096x4096 image (3328 MiB); a smaller image or fewer VPLs need less"
+        );
+    }
 }

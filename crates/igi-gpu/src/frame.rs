@@ -3,7 +3,7 @@
 //! its own timestamp pair. The renderer owns the scene on the GPU, the passes and the
 //! frame's buffers; nothing is read back inside a frame.
 
-use crate::context::{GpuContext, GpuError};
+use crate::context::{GpuContext, GpuError, SMALLER_FRAME};
 use crate::layout::{FrameParams, Vpl};
 use crate::passes::compose::ComposePass;
 use crate::passes::direct::{DirectBindings, DirectPass};
@@ -44,6 +44,9 @@ pub struct FrameOutput {
     /// GPU time from the first stage's start to the last one's end.
     pub frame_ms: Option<f64>,
 }
+
+/// How many buffers [`ImageBuffers`] holds, each 16 bytes per pixel.
+pub const IMAGE_BUFFERS: u32 = 13;
 
 /// Buffers sized by the image.
 struct ImageBuffers {
@@ -298,32 +301,43 @@ impl Renderer {
         Ok(())
     }
 
-    fn ensure_images(&mut self, device: &wgpu::Device, width: u32, height: u32) {
+    /// The image buffers for `width` x `height`: made again when the size changes, the
+    /// old ones freed first (the new set may need their memory).
+    fn ensure_images(&mut self, ctx: &GpuContext, width: u32, height: u32) -> Result<(), GpuError> {
         if let Some(b) = &self.images {
             if b.width == width && b.height == height {
-                return;
+                return Ok(());
             }
         }
+        self.images = None;
         let size = width as u64 * height as u64 * 16;
-        self.images = Some(ImageBuffers {
-            width,
-            height,
-            direct: storage(device, "direct", size),
-            position: storage(device, "gbuffer position", size),
-            normal: storage(device, "gbuffer normal", size),
-            geometric: storage(device, "gbuffer geometric normal", size),
-            albedo: storage(device, "gbuffer albedo", size),
-            mirror: [
-                storage(device, "mirror position", size),
-                storage(device, "mirror normal", size),
-                storage(device, "mirror geometric normal", size),
-                storage(device, "mirror weight", size),
-            ],
-            irradiance: storage(device, "irradiance", size),
-            filtered_low: storage(device, "irradiance after discontinuity", size),
-            filtered: storage(device, "irradiance full resolution", size),
-            color: storage(device, "color", size),
-        });
+        let device = &ctx.device;
+        let images = ctx.allocate(
+            || format!("the {IMAGE_BUFFERS} frame buffers of a {width}x{height} image"),
+            IMAGE_BUFFERS as u64 * size.max(16),
+            SMALLER_FRAME,
+            || ImageBuffers {
+                width,
+                height,
+                direct: storage(device, "direct", size),
+                position: storage(device, "gbuffer position", size),
+                normal: storage(device, "gbuffer normal", size),
+                geometric: storage(device, "gbuffer geometric normal", size),
+                albedo: storage(device, "gbuffer albedo", size),
+                mirror: [
+                    storage(device, "mirror position", size),
+                    storage(device, "mirror normal", size),
+                    storage(device, "mirror geometric normal", size),
+                    storage(device, "mirror weight", size),
+                ],
+                irradiance: storage(device, "irradiance", size),
+                filtered_low: storage(device, "irradiance after discontinuity", size),
+                filtered: storage(device, "irradiance full resolution", size),
+                color: storage(device, "color", size),
+            },
+        )?;
+        self.images = Some(images);
+        Ok(())
     }
 
     fn ensure_vpl_slots(&mut self, ctx: &GpuContext, slots: u64) -> Result<(), GpuError> {
@@ -338,11 +352,18 @@ impl Renderer {
                 ctx.max_storage_binding() >> 20
             )));
         }
-        self.vpl_buffers = Some(VplBuffers {
-            slots,
-            slot_buffer: storage(&ctx.device, "vpl slots", bytes),
-            vpls: storage(&ctx.device, "vpls", bytes),
-        });
+        self.vpl_buffers = None;
+        let buffers = ctx.allocate(
+            || format!("the VPL buffers for {slots} VPL slots"),
+            2 * bytes.max(16),
+            "fewer VPLs or bounces need less",
+            || VplBuffers {
+                slots,
+                slot_buffer: storage(&ctx.device, "vpl slots", bytes),
+                vpls: storage(&ctx.device, "vpls", bytes),
+            },
+        )?;
+        self.vpl_buffers = Some(buffers);
         Ok(())
     }
 
@@ -606,7 +627,7 @@ impl Renderer {
         self.ensure_permutations(ctx, settings.seed);
         let bounces = settings.bounces.max(1);
         self.ensure_vpl_slots(ctx, paths as u64 * bounces as u64)?;
-        self.ensure_images(&ctx.device, settings.width, settings.height);
+        self.ensure_images(ctx, settings.width, settings.height)?;
         self.ensure_ranges(ctx, paths as u64 * bounces as u64);
         let mut params = self.frame_params(
             settings,

@@ -5,7 +5,6 @@ use crate::context::{GpuContext, GpuError};
 use crate::layout::{GpuLight, GpuMaterial, TriShading};
 use igi_core::bvh::Bvh;
 use igi_core::scene::Scene;
-use wgpu::util::DeviceExt;
 
 pub struct SceneBuffers {
     pub layout: wgpu::BindGroupLayout,
@@ -52,17 +51,33 @@ pub fn storage_buffer(
             limit >> 20
         )));
     }
-    let mut bytes = data.to_vec();
-    bytes.resize(bytes.len().max(16), 0);
-    Ok(ctx
-        .device
-        .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some(label),
-            contents: &bytes,
-            usage: wgpu::BufferUsages::STORAGE
-                | wgpu::BufferUsages::COPY_DST
-                | wgpu::BufferUsages::COPY_SRC,
-        }))
+    // Mapped at creation (zeroed) and filled in place: a multiple of 4 bytes, at least 16.
+    let size = (data.len() as u64)
+        .next_multiple_of(wgpu::COPY_BUFFER_ALIGNMENT)
+        .max(16);
+    let buffer = ctx.allocate(
+        || format!("the {label} buffer"),
+        size,
+        "a smaller scene or ray set needs less",
+        || {
+            ctx.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size,
+                usage: wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::COPY_DST
+                    | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: true,
+            })
+        },
+    )?;
+    {
+        let mut mapped = buffer
+            .get_mapped_range_mut(..)
+            .map_err(|e| GpuError::Device(e.to_string()))?;
+        mapped.slice(..data.len()).copy_from_slice(data);
+    }
+    buffer.unmap();
+    Ok(buffer)
 }
 
 /// The point lights as the GPU reads them.

@@ -391,3 +391,124 @@ fn a_device_or_pipe_as_mesh_is_refused_not_read_forever() {
     ]);
     assert_one_error_line(&out, &["/dev/zero", "not a regular file"]);
 }
+
+/// Peak virtual size (VmPeak) of a run of `igi args`, in bytes, sampled from /proc while
+/// it runs (a high-water mark, so the last sample holds nearly all of it).
+fn peak_address_space(args: &[&str]) -> Option<u64> {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_igi"))
+        .args(args)
+        .env("XDG_RUNTIME_DIR", "/tmp")
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .expect("run igi");
+    let status = format!("/proc/{}/status", child.id());
+    let mut peak = 0;
+    loop {
+        if let Ok(text) = std::fs::read_to_string(&status) {
+            let kib = text
+                .lines()
+                .find_map(|l| l.strip_prefix("VmPeak:"))
+                .and_then(|v| v.trim().trim_end_matches("kB").trim().parse::<u64>().ok());
+            peak = peak.max(kib.unwrap_or(0) * 1024);
+        }
+        if let Some(exit) = child.try_wait().expect("wait for igi") {
+            return (exit.success() && peak > 0).then_some(peak);
+        }
+        std::thread::sleep(std::time::Duration::from_millis(1));
+    }
+}
+
+#[test]
+fn out_of_memory_in_a_frame_is_one_clear_error() {
+    // A software adapter's "GPU memory" is the process's own: limiting the address space
+    // of an `igi` run (prlimit --as) makes its large frame buffers fail to allocate for
+    // real, in the driver, as they would on a GPU whose memory is full. Nothing large is
+    // ever touched: the allocations that fail reserve no memory, and the ones that
+    // succeed are freed before the frame runs.
+    let skip = |why: &str| eprintln!("skipped: {why}");
+    if !Path::new("/proc/self/status").exists() {
+        return skip("no /proc to measure the address space of a run");
+    }
+    if Command::new("prlimit").arg("--version").output().is_err() {
+        return skip("prlimit (util-linux) is not installed");
+    }
+    let ctx = match igi_gpu::GpuContext::new(&igi_gpu::AdapterChoice::Best) {
+        Ok(ctx) => ctx,
+        Err(e) => return skip(&format!("no GPU adapter ({e})")),
+    };
+    if format!("{:?}", ctx.info.device_type) != "Cpu" {
+        return skip(&format!(
+            "{} is not a software adapter: an address-space limit does not bound its memory",
+            ctx.describe()
+        ));
+    }
+    // Frame buffers of at most 128 MiB each (and within one storage binding, else the
+    // size check refuses the image before any allocation).
+    let per_buffer = ctx.max_storage_binding().min(128 << 20);
+    let side = ((per_buffer / 16) as f64).sqrt() as u64;
+    let frame = 13 * side * side * 16;
+    // Room above a small run's peak for what a frame needs besides its image buffers,
+    // and well short of those.
+    let margin = (512 << 20).min(frame / 3);
+    drop(ctx);
+    let d = temp_dir("oom");
+    let base = d.join("base.png");
+    let Some(baseline) = peak_address_space(&[
+        "render",
+        "--builtin",
+        "cornell-box",
+        "--width",
+        "16",
+        "--height",
+        "16",
+        "--vpls",
+        "10",
+        "-o",
+        base.to_str().unwrap(),
+    ]) else {
+        return skip("a small render failed or its address space could not be read");
+    };
+    let limit = baseline + margin;
+    let (png, exr) = (d.join("oom.png"), d.join("oom.exr"));
+    let side = side.to_string();
+    let out = Command::new("prlimit")
+        .arg(format!("--as={limit}"))
+        .arg("--")
+        .arg(env!("CARGO_BIN_EXE_igi"))
+        .args([
+            "render",
+            "--builtin",
+            "cornell-box",
+            "--width",
+            &side,
+            "--height",
+            &side,
+            "--vpls",
+            "10",
+            "-o",
+            png.to_str().unwrap(),
+            "--exr",
+            exr.to_str().unwrap(),
+        ])
+        .env("XDG_RUNTIME_DIR", "/tmp")
+        .output()
+        .expect("run prlimit");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    eprintln!(
+        "address space limited to {} MiB (a small run peaks at {} MiB), {side}x{side} image ({} MiB of frame buffers):\n{stderr}",
+        limit >> 20,
+        baseline >> 20,
+        frame.div_ceil(1 << 20)
+    );
+    // An exit through a signal (the driver crashing, an aborted allocation) has no code.
+    assert_eq!(out.status.code(), Some(1), "{:?}: {stderr}", out.status);
+    // The first large allocation, the frame buffers, is the one that fails.
+    assert_one_error_line(&out, &["out of memory", "frame buffers", "MiB"]);
+    let left: Vec<String> = std::fs::read_dir(&d)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|name| name != "base.png")
+        .collect();
+    assert!(left.is_empty(), "left behind: {left:?}");
+}
