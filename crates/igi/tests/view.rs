@@ -22,7 +22,10 @@ fn igi(args: &[&str]) -> Output {
 }
 
 /// `igi ARGS` inside a fresh Xvfb display, or `None` (printed) when there is no xvfb-run.
+/// One at a time: `xvfb-run -a` picks a free display number racily.
 fn igi_in_xvfb(args: &[&str]) -> Option<Output> {
+    static ONE_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
+    let _turn = ONE_AT_A_TIME.lock().unwrap_or_else(|p| p.into_inner());
     let found = Command::new("xvfb-run").arg("--help").output().is_ok();
     if !found {
         eprintln!("skipped: xvfb-run is not installed (apt-get install xvfb xauth)");
