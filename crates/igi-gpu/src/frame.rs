@@ -23,9 +23,9 @@ use igi_core::settings::{
     Accelerations, FilterMode, GeometryBound, InterleavePattern, OutputBuffer, RenderSettings,
 };
 
-/// Most stages a frame can have (vpl, direct, mirror indirect, indirect, two filters,
-/// compose), each with its timestamp pair.
-pub const MAX_STAGES: u32 = 7;
+/// Most stages a frame can have (vpl, direct, mirror indirect, mirror discontinuity,
+/// indirect, two filters, compose), each with its timestamp pair.
+pub const MAX_STAGES: u32 = 8;
 
 /// Light paths of the pilot run that estimates VPLs per path.
 pub const PILOT_PATHS: u32 = 4096;
@@ -46,7 +46,7 @@ pub struct FrameOutput {
 }
 
 /// How many buffers [`ImageBuffers`] holds, each 16 bytes per pixel.
-pub const IMAGE_BUFFERS: u32 = 13;
+pub const IMAGE_BUFFERS: u32 = 15;
 
 /// Buffers sized by the image.
 struct ImageBuffers {
@@ -60,6 +60,10 @@ struct ImageBuffers {
     /// The first diffuse hit of each pixel's mirror chain: position, shading normal,
     /// geometric normal, weight (mirror.wgsl).
     mirror: [wgpu::Buffer; 4],
+    /// E at the mirrored hits (full resolution), as the mirror pass leaves it, and after
+    /// the discontinuity buffer over the mirrored hits (interleaved frames).
+    mirror_irradiance: wgpu::Buffer,
+    mirror_filtered: wgpu::Buffer,
     /// E at the indirect resolution, as the indirect pass leaves it.
     irradiance: wgpu::Buffer,
     /// After the discontinuity buffer (indirect resolution).
@@ -86,6 +90,9 @@ pub struct Renderer {
     compose: ComposePass,
     profiler: Profiler,
     params: wgpu::Buffer,
+    /// The frame's parameters as the discontinuity buffer over the mirrored hits reads
+    /// them: its image is the full-resolution one (no downsampling there).
+    mirror_params: wgpu::Buffer,
     vpl_header: wgpu::Buffer,
     /// The scrambled Halton sequence's digit permutations, for the seed they were made for.
     halton_perms: (u32, wgpu::Buffer),
@@ -159,6 +166,12 @@ impl Renderer {
             profiler: Profiler::new(ctx, MAX_STAGES),
             params: device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("frame params"),
+                size: std::mem::size_of::<FrameParams>() as u64,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }),
+            mirror_params: device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("mirror filter params"),
                 size: std::mem::size_of::<FrameParams>() as u64,
                 usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
                 mapped_at_creation: false,
@@ -270,6 +283,8 @@ impl Renderer {
                 &b.mirror[3],
                 &b.filtered_low,
                 &b.filtered,
+                &b.mirror_irradiance,
+                &b.mirror_filtered,
                 &b.color,
             ]
             .iter()
@@ -330,6 +345,8 @@ impl Renderer {
                     storage(device, "mirror geometric normal", size),
                     storage(device, "mirror weight", size),
                 ],
+                mirror_irradiance: storage(device, "mirror irradiance", size),
+                mirror_filtered: storage(device, "mirror irradiance after discontinuity", size),
                 irradiance: storage(device, "irradiance", size),
                 filtered_low: storage(device, "irradiance after discontinuity", size),
                 filtered: storage(device, "irradiance full resolution", size),
@@ -638,6 +655,16 @@ impl Renderer {
         params.count_rays = self.counting as u32;
         ctx.queue
             .write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
+        if self.has_mirrors {
+            let mirror = FrameParams {
+                low_width: params.width,
+                low_height: params.height,
+                downsample: 1,
+                ..params
+            };
+            ctx.queue
+                .write_buffer(&self.mirror_params, 0, bytemuck::bytes_of(&mirror));
+        }
         let mut encoder = ctx
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
@@ -823,6 +850,7 @@ impl Renderer {
         );
 
         // Scenes without mirrors have no mirrored hits: no stage.
+        let mut mirror_e = &img.mirror_irradiance;
         if self.has_mirrors {
             let mirror_bind = self.mirror.bind(
                 device,
@@ -834,7 +862,7 @@ impl Renderer {
                     &img.mirror[1],
                     &img.mirror[2],
                     &img.mirror[3],
-                    &img.direct,
+                    &img.mirror_irradiance,
                 ],
             );
             let i = stage("mirror indirect");
@@ -848,6 +876,31 @@ impl Renderer {
                 &mirror_bind,
                 Some(&ranges),
             );
+            // Interleaved mirrored hits: the discontinuity buffer over their own record.
+            if a.interleave.0 * a.interleave.1 > 1 {
+                let bind = self.filter.bind(
+                    device,
+                    &[
+                        &self.mirror_params,
+                        &img.mirror[0],
+                        &img.mirror[1],
+                        &img.mirror_irradiance,
+                        &img.mirror_filtered,
+                    ],
+                );
+                let i = stage("mirror discontinuity");
+                dispatch(
+                    encoder,
+                    p,
+                    i,
+                    "mirror discontinuity",
+                    &self.filter.steps(Filter::Discontinuity, full, full),
+                    scene,
+                    &bind,
+                    None,
+                );
+                mirror_e = &img.mirror_filtered;
+            }
         }
 
         let indirect_bind = self.indirect.bind(
@@ -911,6 +964,8 @@ impl Renderer {
                 &img.color,
                 &img.position,
                 &img.normal,
+                &img.mirror[3],
+                mirror_e,
             ],
         );
         let i = stage("compose");

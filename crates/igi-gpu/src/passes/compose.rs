@@ -11,11 +11,12 @@ pub struct ComposePass {
 
 impl ComposePass {
     pub fn new(device: &wgpu::Device, scene_layout: &wgpu::BindGroupLayout) -> ComposePass {
-        // params, direct, albedo, irradiance, color, G-buffer position and normal
+        // params, direct, albedo, irradiance, color, G-buffer position and normal, the
+        // mirrored hits' weight and E
         let layout = pass_layout(
             device,
             "compose",
-            &[UNIFORM, READ, READ, READ, WRITE, READ, READ],
+            &[UNIFORM, READ, READ, READ, WRITE, READ, READ, READ, READ],
         );
         ComposePass {
             pipeline: pipeline(device, "compose", "main", &[scene_layout, &layout]),
@@ -23,7 +24,7 @@ impl ComposePass {
         }
     }
 
-    pub fn bind(&self, device: &wgpu::Device, buffers: &[&wgpu::Buffer; 7]) -> wgpu::BindGroup {
+    pub fn bind(&self, device: &wgpu::Device, buffers: &[&wgpu::Buffer; 9]) -> wgpu::BindGroup {
         bind(device, "compose", &self.layout, buffers)
     }
 

@@ -1,7 +1,8 @@
 // compose.wgsl: the final image (paper section 4, last stage):
 // L = direct_specular + (rho_d(x) / pi) E(x), linear radiance; tone mapping happens only
 // when an image is written. `params.output` picks another buffer for inspection (the
-// viewer's buffer choice): direct, indirect, E, normals or depth of the primary hits.
+// viewer's buffer choice): direct (with the indirect light seen in mirrors), indirect,
+// E, normals or depth of the primary hits.
 // `irradiance_in` is E at full resolution: the indirect pass's output, or the last filter's.
 
 @group(1) @binding(1) var<storage, read> direct_in: array<vec4<f32>>;
@@ -10,6 +11,10 @@
 @group(1) @binding(4) var<storage, read_write> color_out: array<vec4<f32>>;
 @group(1) @binding(5) var<storage, read> gbuf_position: array<vec4<f32>>;
 @group(1) @binding(6) var<storage, read> gbuf_normal: array<vec4<f32>>;
+// Indirect light at the pixel's mirrored hit (mirror.wgsl): weight (w = 1 where there is
+// one) times E there, after the mirror discontinuity filter when interleaved.
+@group(1) @binding(7) var<storage, read> mirror_weight: array<vec4<f32>>;
+@group(1) @binding(8) var<storage, read> mirror_irradiance: array<vec4<f32>>;
 
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
@@ -17,7 +22,11 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     let pixel = gid.y * params.width + gid.x;
-    let direct = direct_in[pixel].xyz;
+    var direct = direct_in[pixel].xyz;
+    let mirrored = mirror_weight[pixel];
+    if (mirrored.w > 0.0) {
+        direct += mirrored.xyz * mirror_irradiance[pixel].xyz;
+    }
     let e = irradiance_in[pixel].xyz;
     let indirect = gbuf_albedo[pixel].xyz / PI * e;
     var c = direct + indirect;

@@ -3,7 +3,8 @@
 // mirror part continues the Whitted tree up to the depth limit, and at hits reached
 // through mirrors the indirect diffuse term comes from the full VPL set (no screen-space
 // pass reaches them): at the first such hit it is gathered by mirror.wgsl from the
-// record written here, at any later one (a mirror seen in a mirror) here. Writes the
+// record written here (compose adds it), at any later one (a mirror seen in a mirror)
+// here. Writes the
 // G-buffer of the primary hit.
 // When the VPL list is gathered in several ranges (see gather.wgsl), the first dispatch
 // does everything and later ones walk the mirror chain again, adding only their range's
@@ -41,6 +42,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         gbuf_geometric[pixel] = vec4<f32>(0.0);
         gbuf_albedo[pixel] = vec4<f32>(0.0);
         mirror_position[pixel] = vec4<f32>(0.0);
+        mirror_weight[pixel] = vec4<f32>(0.0);
     } else {
         // Later ranges only add light at mirrored hits: nothing to do without a mirror.
         if (gbuf_albedo[pixel].w == 0.0) {
@@ -50,6 +52,8 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     var traced = 0u;
     var recorded = false;
+    // Length of the chain so far: the mirrored hit's depth for the mirror filter.
+    var travelled = 0.0;
     for (var depth = 0u; depth <= params.mirror_depth; depth += 1u) {
         let hit = trace_closest(origin, dir, INFINITY);
         traced += 1u;
@@ -57,6 +61,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             break;
         }
         let s = surface_at(origin, dir, hit);
+        travelled += hit.t;
         if (depth == 0u && first_range) {
             gbuf_position[pixel] = vec4<f32>(s.position, 1.0);
             gbuf_normal[pixel] = vec4<f32>(s.shading_normal, hit.t);
@@ -75,9 +80,9 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
                 recorded = true;
                 if (first_range) {
                     mirror_position[pixel] = vec4<f32>(s.position, 1.0);
-                    mirror_normal[pixel] = vec4<f32>(s.shading_normal, 0.0);
+                    mirror_normal[pixel] = vec4<f32>(s.shading_normal, travelled);
                     mirror_geometric[pixel] = vec4<f32>(s.geometric_normal, 0.0);
-                    mirror_weight[pixel] = vec4<f32>(weight, 0.0);
+                    mirror_weight[pixel] = vec4<f32>(weight, 1.0);
                 }
             } else if (depth > 0u) {
                 e += vpl_irradiance(s.position, s.geometric_normal, s.shading_normal, gather_first(), gather_last(), 1u);

@@ -31,6 +31,33 @@ fn gather_last() -> u32 {
     return min(gather_range.end, vpl_header.count);
 }
 
+// Interleaved sampling (paper section 4.3): the VPL subset of pixel (x, y) of the image
+// being gathered (the indirect term's, or the mirrored hits'): its place in its n x m
+// tile, through a permutation drawn for the tile (seeded Fisher-Yates) when the pattern
+// is irregular.
+fn interleave_subset(x: u32, y: u32) -> u32 {
+    let n = params.interleave_n;
+    let m = params.interleave_m;
+    let local = (x % n) + n * (y % m);
+    if (params.pattern == 0u) {
+        return local;
+    }
+    var perm: array<u32, 64>;
+    let count = n * m;
+    for (var i = 0u; i < count; i += 1u) {
+        perm[i] = i;
+    }
+    var h = hash_u32(params.seed ^ hash_u32((x / n) * 0x8da6b343u ^ (y / m) * 0xd8163841u));
+    for (var i = count - 1u; i > 0u; i -= 1u) {
+        h = hash_u32(h + 0x9e3779b9u);
+        let j = h % (i + 1u);
+        let t = perm[i];
+        perm[i] = perm[j];
+        perm[j] = t;
+    }
+    return perm[local];
+}
+
 fn vpl_irradiance(p: vec3<f32>, ng: vec3<f32>, ns: vec3<f32>, first: u32, count: u32, stride: u32) -> vec3<f32> {
     var e = vec3<f32>(0.0);
     let origin = offset_ray_origin(p, ng);

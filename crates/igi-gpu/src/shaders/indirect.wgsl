@@ -14,31 +14,6 @@
 // At the indirect term's resolution (low_width x low_height).
 @group(1) @binding(6) var<storage, read_write> irradiance_out: array<vec4<f32>>;
 
-// The VPL subset of low-resolution pixel (x, y): its place in its n x m tile, through a
-// permutation drawn for the tile (seeded Fisher-Yates) when the pattern is irregular.
-fn interleave_subset(x: u32, y: u32) -> u32 {
-    let n = params.interleave_n;
-    let m = params.interleave_m;
-    let local = (x % n) + n * (y % m);
-    if (params.pattern == 0u) {
-        return local;
-    }
-    var perm: array<u32, 64>;
-    let count = n * m;
-    for (var i = 0u; i < count; i += 1u) {
-        perm[i] = i;
-    }
-    var h = hash_u32(params.seed ^ hash_u32((x / n) * 0x8da6b343u ^ (y / m) * 0xd8163841u));
-    for (var i = count - 1u; i > 0u; i -= 1u) {
-        h = hash_u32(h + 0x9e3779b9u);
-        let j = h % (i + 1u);
-        let t = perm[i];
-        perm[i] = perm[j];
-        perm[j] = t;
-    }
-    return perm[local];
-}
-
 // One pixel's share of E: its subset's VPLs from `lane` on, every `lanes`-th.
 fn pixel_sum(x: u32, y: u32, lane: u32, lanes: u32) -> vec3<f32> {
     let pixel = representative_pixel(x, y);

@@ -1,34 +1,50 @@
 // mirror.wgsl: indirect diffuse light at hits seen through mirrors (paper section 4: "at
 // hits reached through mirrors the indirect term is gathered from the full VPL set"; the
 // paper lists its cost as future work). The direct pass records, per pixel, the first
-// diffuse hit of its mirror chain; this pass gathers E there from every VPL and adds
-// weight x E to the pixel's direct + specular radiance. A separate pass, so that the few
-// pixels that see a mirror can split their VPLs over lanes instead of holding back the
-// direct pass's warps.
+// diffuse hit of its mirror chain; this pass gathers E there and stores it, without the
+// weight, for compose to add weight x E to the pixel's direct + specular radiance. A
+// separate pass, so that the few pixels that see a mirror can split their VPLs over lanes
+// instead of holding back the direct pass's warps.
+// With interleaved sampling (section 4.3) the mirrored hits are interleaved too: each
+// pixel gathers its subset of the VPLs, scaled by the number of subsets, and the
+// discontinuity buffer then runs over the mirrored hits' own positions, normals and
+// depths (filter.wgsl with this record as its G-buffer). Downsampling does not apply.
 
 @group(1) @binding(1) var<storage, read> vpls: array<Vpl>;
 @group(1) @binding(2) var<storage, read> vpl_header: VplHeader;
-// The record: position (w = 1 where there is one), shading normal, geometric normal, and
-// the weight: the chain's mirror throughput times rho / pi of the hit.
+// The record: position (w = 1 where there is one), shading normal (w: the chain's
+// length), geometric normal, and the weight (w = 1 where there is a record): the chain's
+// mirror throughput times rho / pi of the hit.
 @group(1) @binding(3) var<storage, read> mirror_position: array<vec4<f32>>;
 @group(1) @binding(4) var<storage, read> mirror_normal: array<vec4<f32>>;
 @group(1) @binding(5) var<storage, read> mirror_geometric: array<vec4<f32>>;
 @group(1) @binding(6) var<storage, read> mirror_weight: array<vec4<f32>>;
-@group(1) @binding(7) var<storage, read_write> direct_out: array<vec4<f32>>;
+// E at the mirrored hit (full resolution), summed over the dispatches of the VPL ranges.
+@group(1) @binding(7) var<storage, read_write> mirror_irradiance: array<vec4<f32>>;
 
-// This lane's share of the E at pixel's mirrored hit (zero without one).
-fn mirrored_sum(pixel: u32, lane: u32, lanes: u32) -> vec3<f32> {
+// This lane's share of the E at pixel (x, y)'s mirrored hit (zero without one): its
+// interleaving subset's VPLs from `lane` on, every `lanes`-th.
+fn mirrored_sum(x: u32, y: u32, lane: u32, lanes: u32) -> vec3<f32> {
+    let pixel = y * params.width + x;
     let position = mirror_position[pixel];
     if (position.w <= 0.0) {
         return vec3<f32>(0.0);
     }
-    return vpl_irradiance(position.xyz, mirror_geometric[pixel].xyz, mirror_normal[pixel].xyz, gather_first() + lane, gather_last(), lanes);
+    let subsets = params.interleave_n * params.interleave_m;
+    let subset = interleave_subset(x, y);
+    let begin = gather_first();
+    let first = begin + (subset + subsets - begin % subsets) % subsets + lane * subsets;
+    return vpl_irradiance(position.xyz, mirror_geometric[pixel].xyz, mirror_normal[pixel].xyz, first, gather_last(), subsets * lanes);
 }
 
-fn add_mirrored(pixel: u32, e: vec3<f32>) {
-    if (mirror_position[pixel].w > 0.0) {
-        direct_out[pixel] = vec4<f32>(direct_out[pixel].xyz + mirror_weight[pixel].xyz * e, 1.0);
+// Add this dispatch's sum to what earlier VPL ranges left, scaled by the subset count.
+fn store_mirrored(x: u32, y: u32, sum: vec3<f32>) {
+    let pixel = y * params.width + x;
+    var e = vec3<f32>(0.0);
+    if (gather_first() > 0u) {
+        e = mirror_irradiance[pixel].xyz;
     }
+    mirror_irradiance[pixel] = vec4<f32>(e + f32(params.interleave_n * params.interleave_m) * sum, 1.0);
 }
 
 @compute @workgroup_size(8, 8)
@@ -36,8 +52,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (gid.x >= params.width || gid.y >= params.height) {
         return;
     }
-    let pixel = gid.y * params.width + gid.x;
-    add_mirrored(pixel, mirrored_sum(pixel, 0u, 1u));
+    store_mirrored(gid.x, gid.y, mirrored_sum(gid.x, gid.y, 0u, 1u));
 }
 
 @compute @workgroup_size(64)
@@ -45,14 +60,13 @@ fn main_lanes(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation
     let p = lane_pixel(group, l);
     let lane = l % VPL_LANES;
     let inside = p.x < params.width && p.y < params.height;
-    let pixel = p.y * params.width + p.x;
     var sum = vec3<f32>(0.0);
     if (inside) {
-        sum = mirrored_sum(pixel, lane, VPL_LANES);
+        sum = mirrored_sum(p.x, p.y, lane, VPL_LANES);
     }
     lane_sums[l] = vec4<f32>(sum, 0.0);
     workgroupBarrier();
     if (inside && lane == 0u) {
-        add_mirrored(pixel, lanes_total(l));
+        store_mirrored(p.x, p.y, lanes_total(l));
     }
 }
