@@ -105,19 +105,28 @@ fn box_near(bmin: vec3<f32>, bmax: vec3<f32>, r: TraceRay, tmax: f32) -> f32 {
     return select(-1.0, near, near <= far);
 }
 
+// (v[kx], v[ky], v[kz]) of the ray's Woop axes, by selects. Indexing a vector with a
+// run-time index (v[r.kx]) compiled to something much slower on NVIDIA's Vulkan driver
+// (the traversal ran 14-17% slower with it on an H200, docs/PERFORMANCE.md attempt 5);
+// the values and hence the results are the same.
+fn perm(v: vec3<f32>, r: TraceRay) -> vec3<f32> {
+    let k = vec3<u32>(r.kx, r.ky, r.kz);
+    return select(select(vec3<f32>(v.x), vec3<f32>(v.y), k == vec3<u32>(1u)), vec3<f32>(v.z), k == vec3<u32>(2u));
+}
+
 // Watertight two-sided ray-triangle test: (t, u, v) of a hit with 0 < t < tmax, else
 // t = -1. Edge and vertex hits count: a ray through a shared edge or vertex never leaks.
 fn intersect_triangle(r: TraceRay, v0: vec3<f32>, v1: vec3<f32>, v2: vec3<f32>, tmax: f32) -> vec3<f32> {
     let miss = vec3<f32>(-1.0, 0.0, 0.0);
-    let a = v0 - r.origin;
-    let b = v1 - r.origin;
-    let c = v2 - r.origin;
-    let ax = a[r.kx] - r.shear.x * a[r.kz];
-    let ay = a[r.ky] - r.shear.y * a[r.kz];
-    let bx = b[r.kx] - r.shear.x * b[r.kz];
-    let by = b[r.ky] - r.shear.y * b[r.kz];
-    let cx = c[r.kx] - r.shear.x * c[r.kz];
-    let cy = c[r.ky] - r.shear.y * c[r.kz];
+    let a = perm(v0 - r.origin, r);
+    let b = perm(v1 - r.origin, r);
+    let c = perm(v2 - r.origin, r);
+    let ax = a.x - r.shear.x * a.z;
+    let ay = a.y - r.shear.y * a.z;
+    let bx = b.x - r.shear.x * b.z;
+    let by = b.y - r.shear.y * b.z;
+    let cx = c.x - r.shear.x * c.z;
+    let cy = c.y - r.shear.y * c.z;
     // Edge functions U (weight of v0), V (v1), W (v2) as pairs of rounded products: the
     // signs come from comparing them, never from a (possibly fused) difference.
     let pu1 = cx * by;
@@ -137,9 +146,9 @@ fn intersect_triangle(r: TraceRay, v0: vec3<f32>, v1: vec3<f32>, v2: vec3<f32>, 
     if (det == 0.0) {
         return miss;
     }
-    let az = r.shear.z * a[r.kz];
-    let bz = r.shear.z * b[r.kz];
-    let cz = r.shear.z * c[r.kz];
+    let az = r.shear.z * a.z;
+    let bz = r.shear.z * b.z;
+    let cz = r.shear.z * c.z;
     let tt = eu * az + ev * bz + ew * cz;
     let rcp = 1.0 / det;
     let t = tt * rcp;
