@@ -167,7 +167,8 @@ struct Viewer {
     frames_rendered: u32,
     stats: Stats,
     last: Instant,
-    /// The first redraw (for the frame rate `--frames` reports).
+    /// When the first frame was presented: the frame rate `--frames` reports leaves out
+    /// the first frame (pipeline compilation, the pilot run).
     started: Option<Instant>,
     diagonal: f32,
     /// Asked by a key, done after the next frame.
@@ -336,7 +337,6 @@ impl Viewer {
     /// the display and the panel drawn into the window. Returns whether to exit.
     fn redraw(&mut self, opts: &ViewOptions) -> Result<bool> {
         let now = Instant::now();
-        self.started.get_or_insert(now);
         let seconds = (now - self.last).as_secs_f32().min(0.25);
         self.last = now;
         let moved = self
@@ -463,19 +463,24 @@ impl Viewer {
                 Err(e) => format!("screenshot failed: {e:#}"),
             });
         }
+        if self.frames_rendered == 1 {
+            self.started.get_or_insert_with(Instant::now);
+        }
         if let Some(n) = opts.frames {
             if self.frames_rendered >= n {
-                let started = self.started.get_or_insert(now);
-                let seconds = started.elapsed().as_secs_f64();
-                eprintln!(
-                    "{n} frames of {width}x{height} in a {}x{} window in {seconds:.2} s: {:.2} fps{}",
-                    self.config.width,
-                    self.config.height,
-                    n as f64 / seconds.max(1e-9),
-                    self.stats
-                        .gpu_ms
-                        .map_or(String::new(), |ms| format!(" (last frame {ms:.3} ms of GPU time)")),
-                );
+                if let Some(started) = self.started.filter(|_| n > 1) {
+                    let seconds = started.elapsed().as_secs_f64();
+                    eprintln!(
+                        "frames 2 to {n} of {width}x{height} in a {}x{} window: {:.2} fps, {:.1} ms a frame{}",
+                        self.config.width,
+                        self.config.height,
+                        (n - 1) as f64 / seconds.max(1e-9),
+                        seconds * 1e3 / (n - 1) as f64,
+                        self.stats.gpu_ms.map_or(String::new(), |ms| format!(
+                            " (the last {ms:.3} ms of GPU time)"
+                        )),
+                    );
+                }
                 if let Some(path) = &opts.screenshot {
                     eprintln!("{}", self.save(path)?);
                 }
