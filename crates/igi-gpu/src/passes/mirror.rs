@@ -6,8 +6,10 @@ use super::{bind, pass_layout, LanePipelines};
 use crate::scene_buffers::{READ, UNIFORM, WRITE};
 
 /// Lanes per pixel of the mirror pass: few pixels see a mirror (18000 of 480000 in the
-/// conference room), so their VPL loops are split widely; one lane on a software adapter.
-/// `IGI_MIRROR_LANES` (1, 8 or 32) overrides it, for measurements.
+/// conference room), so their VPL loops are split over 8 threads; one lane on a software
+/// adapter. 8 beat 32 and 1 on the H200 at 800 x 600 and 1920 x 1080, canonical and
+/// interleaved (docs/PERFORMANCE.md, attempt 17). `IGI_MIRROR_LANES` (1, 8 or 32)
+/// overrides it, for measurements.
 pub fn mirror_lanes(software: bool) -> u32 {
     if let Some(l) = std::env::var("IGI_MIRROR_LANES")
         .ok()
@@ -20,7 +22,7 @@ pub fn mirror_lanes(software: bool) -> u32 {
     if software {
         1
     } else {
-        32
+        8
     }
 }
 
