@@ -8,26 +8,44 @@ mod common;
 use common::*;
 use glam::Vec3;
 use igi_core::bvh::{offset_ray_origin, Bvh};
-use igi_core::scene::builtin;
+use igi_core::scene::{builtin, Camera, Scene};
 use igi_core::settings::{OutputBuffer, RenderSettings};
 use igi_core::vpl::{reflect, surface_at};
 use igi_gpu::Renderer;
 use std::f32::consts::PI;
 
-#[test]
-fn mirrored_hits_gather_from_all_vpls() {
-    let Some(ctx) = gpu() else { return };
+/// The built-in Cornell box with its floor made of `diffuse` + `mirror`.
+fn mirror_floor(diffuse: Vec3, mirror: Vec3) -> Scene {
     let mut scene = builtin::builtin_scene("cornell-box").unwrap();
-    // The floor becomes half mirror, half diffuse.
     scene
         .materials
-        .push(material("floor mirror", Vec3::splat(0.3), Vec3::splat(0.5)));
+        .push(material("floor mirror", diffuse, mirror));
     let floor_material = scene.materials.len() as u32 - 1;
     for t in &mut scene.triangles {
         if t.v.iter().all(|v| v.y.abs() < 1e-4) {
             t.material = floor_material;
         }
     }
+    scene
+}
+
+/// The primary ray direction of pixel (x, y), as frame.wgsl makes it (frame 0).
+fn primary_dir(cam: &Camera, width: u32, height: u32, x: u32, y: u32) -> Vec3 {
+    let forward = (cam.target - cam.eye).normalize();
+    let right = forward.cross(cam.up).normalize();
+    let up = right.cross(forward);
+    let tan = (cam.fov_y_deg.to_radians() * 0.5).tan();
+    let aspect = width as f32 / height as f32;
+    let sx = (2.0 * (x as f32 + 0.5) / width as f32 - 1.0) * tan * aspect;
+    let sy = (1.0 - 2.0 * (y as f32 + 0.5) / height as f32) * tan;
+    (forward + sx * right + sy * up).normalize()
+}
+
+#[test]
+fn mirrored_hits_gather_from_all_vpls() {
+    let Some(ctx) = gpu() else { return };
+    // The floor becomes half mirror, half diffuse.
+    let scene = mirror_floor(Vec3::splat(0.3), Vec3::splat(0.5));
     let bvh = Bvh::build(&scene.triangles);
     let settings = RenderSettings {
         width: 48,
@@ -76,16 +94,10 @@ fn mirrored_hits_gather_from_all_vpls() {
     };
 
     let cam = scene.camera;
-    let forward = (cam.target - cam.eye).normalize();
-    let right = forward.cross(cam.up).normalize();
-    let up = right.cross(forward);
-    let tan = (cam.fov_y_deg.to_radians() * 0.5).tan();
     let (mut checked, mut off) = (0, 0);
     for y in 0..settings.height {
         for x in 0..settings.width {
-            let sx = (2.0 * (x as f32 + 0.5) / settings.width as f32 - 1.0) * tan;
-            let sy = (1.0 - 2.0 * (y as f32 + 0.5) / settings.height as f32) * tan;
-            let dir = (forward + sx * right + sy * up).normalize();
+            let dir = primary_dir(&cam, settings.width, settings.height, x, y);
             let Some(hit) = bvh.trace_closest(cam.eye, dir, f32::INFINITY) else {
                 continue;
             };
@@ -129,16 +141,7 @@ fn mirrored_hits_gather_from_all_vpls() {
 #[test]
 fn interleaved_mirrored_hits_stay_close_to_the_full_gather() {
     let Some(ctx) = gpu() else { return };
-    let mut scene = builtin::builtin_scene("cornell-box").unwrap();
-    scene
-        .materials
-        .push(material("floor mirror", Vec3::ZERO, Vec3::splat(0.8)));
-    let floor_material = scene.materials.len() as u32 - 1;
-    for t in &mut scene.triangles {
-        if t.v.iter().all(|v| v.y.abs() < 1e-4) {
-            t.material = floor_material;
-        }
-    }
+    let mut scene = mirror_floor(Vec3::ZERO, Vec3::splat(0.8));
     // Looking down at the floor, so that the mirror fills much of the image.
     let ahead = (scene.camera.target - scene.camera.eye).normalize();
     scene.camera.target = scene.camera.eye + ahead - 0.5 * scene.camera.up.normalize();
@@ -163,17 +166,11 @@ fn interleaved_mirrored_hits_stay_close_to_the_full_gather() {
     // The pixels whose primary ray hits the mirror floor.
     let bvh = Bvh::build(&scene.triangles);
     let cam = scene.camera;
-    let forward = (cam.target - cam.eye).normalize();
-    let right = forward.cross(cam.up).normalize();
-    let up = right.cross(forward);
-    let tan = (cam.fov_y_deg.to_radians() * 0.5).tan();
     let (mut sum_full, mut sum_il, mut se, mut s2, mut pixels, mut differ) =
         (0.0, 0.0, 0.0, 0.0, 0, 0);
     for y in 0..base.height {
         for x in 0..base.width {
-            let sx = (2.0 * (x as f32 + 0.5) / base.width as f32 - 1.0) * tan;
-            let sy = (1.0 - 2.0 * (y as f32 + 0.5) / base.height as f32) * tan;
-            let dir = (forward + sx * right + sy * up).normalize();
+            let dir = primary_dir(&cam, base.width, base.height, x, y);
             let Some(hit) = bvh.trace_closest(cam.eye, dir, f32::INFINITY) else {
                 continue;
             };

@@ -58,6 +58,29 @@ fn interleave_subset(x: u32, y: u32) -> u32 {
     return perm[local];
 }
 
+// E at surface point p from the interleaving subset of pixel (x, y) of the image being
+// gathered: the subset's VPLs within this dispatch's range, from `lane` on, every
+// `lanes`-th (not yet scaled by the number of subsets).
+fn subset_irradiance(p: vec3<f32>, ng: vec3<f32>, ns: vec3<f32>, x: u32, y: u32, lane: u32, lanes: u32) -> vec3<f32> {
+    let subsets = params.interleave_n * params.interleave_m;
+    let subset = interleave_subset(x, y);
+    // First VPL of the subset within the dispatch's range, then this lane's.
+    let begin = gather_first();
+    let first = begin + (subset + subsets - begin % subsets) % subsets + lane * subsets;
+    return vpl_irradiance(p, ng, ns, first, gather_last(), subsets * lanes);
+}
+
+// What a pixel holds after this dispatch: what earlier VPL ranges left (`previous`,
+// ignored in the first range) plus this range's `sum`, scaled by the subset count so
+// that a tile's average stays an unbiased estimate.
+fn accumulated_irradiance(previous: vec4<f32>, sum: vec3<f32>) -> vec4<f32> {
+    var e = vec3<f32>(0.0);
+    if (gather_first() > 0u) {
+        e = previous.xyz;
+    }
+    return vec4<f32>(e + f32(params.interleave_n * params.interleave_m) * sum, 1.0);
+}
+
 fn vpl_irradiance(p: vec3<f32>, ng: vec3<f32>, ns: vec3<f32>, first: u32, count: u32, stride: u32) -> vec3<f32> {
     var e = vec3<f32>(0.0);
     let origin = offset_ray_origin(p, ng);

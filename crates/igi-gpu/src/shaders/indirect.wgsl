@@ -21,22 +21,12 @@ fn pixel_sum(x: u32, y: u32, lane: u32, lanes: u32) -> vec3<f32> {
     if (position.w <= 0.0) {
         return vec3<f32>(0.0);
     }
-    let subsets = params.interleave_n * params.interleave_m;
-    let subset = interleave_subset(x, y);
-    // First VPL of this pixel's subset within the dispatch's range, then this lane's.
-    let begin = gather_first();
-    let first = begin + (subset + subsets - begin % subsets) % subsets + lane * subsets;
-    return vpl_irradiance(position.xyz, gbuf_geometric[pixel].xyz, gbuf_normal[pixel].xyz, first, gather_last(), subsets * lanes);
+    return subset_irradiance(position.xyz, gbuf_geometric[pixel].xyz, gbuf_normal[pixel].xyz, x, y, lane, lanes);
 }
 
-// Add this dispatch's sum to what earlier VPL ranges left, scaled by the subset count.
 fn store_irradiance(x: u32, y: u32, sum: vec3<f32>) {
     let low = y * params.low_width + x;
-    var e = vec3<f32>(0.0);
-    if (gather_first() > 0u) {
-        e = irradiance_out[low].xyz;
-    }
-    irradiance_out[low] = vec4<f32>(e + f32(params.interleave_n * params.interleave_m) * sum, 1.0);
+    irradiance_out[low] = accumulated_irradiance(irradiance_out[low], sum);
 }
 
 // One thread per pixel, 8 x 8 pixels per workgroup.

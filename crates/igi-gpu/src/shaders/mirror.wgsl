@@ -30,21 +30,12 @@ fn mirrored_sum(x: u32, y: u32, lane: u32, lanes: u32) -> vec3<f32> {
     if (position.w <= 0.0) {
         return vec3<f32>(0.0);
     }
-    let subsets = params.interleave_n * params.interleave_m;
-    let subset = interleave_subset(x, y);
-    let begin = gather_first();
-    let first = begin + (subset + subsets - begin % subsets) % subsets + lane * subsets;
-    return vpl_irradiance(position.xyz, mirror_geometric[pixel].xyz, mirror_normal[pixel].xyz, first, gather_last(), subsets * lanes);
+    return subset_irradiance(position.xyz, mirror_geometric[pixel].xyz, mirror_normal[pixel].xyz, x, y, lane, lanes);
 }
 
-// Add this dispatch's sum to what earlier VPL ranges left, scaled by the subset count.
 fn store_mirrored(x: u32, y: u32, sum: vec3<f32>) {
     let pixel = y * params.width + x;
-    var e = vec3<f32>(0.0);
-    if (gather_first() > 0u) {
-        e = mirror_irradiance[pixel].xyz;
-    }
-    mirror_irradiance[pixel] = vec4<f32>(e + f32(params.interleave_n * params.interleave_m) * sum, 1.0);
+    mirror_irradiance[pixel] = accumulated_irradiance(mirror_irradiance[pixel], sum);
 }
 
 @compute @workgroup_size(8, 8)
