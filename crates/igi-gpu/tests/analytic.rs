@@ -16,13 +16,6 @@ fn point_light_over_diffuse_plane() {
     let rho = Vec3::new(0.5, 0.6, 0.7);
     let intensity = Vec3::new(2.0, 3.0, 4.0);
     let light = Vec3::new(0.5, 1.0, 0.3);
-    let s = 10.0;
-    let corners = [
-        Vec3::new(-s, 0.0, -s),
-        Vec3::new(s, 0.0, -s),
-        Vec3::new(s, 0.0, s),
-        Vec3::new(-s, 0.0, s),
-    ];
     let camera = Camera {
         eye: Vec3::new(0.2, 2.0, 1.5),
         target: Vec3::new(0.0, 0.0, 0.0),
@@ -31,10 +24,7 @@ fn point_light_over_diffuse_plane() {
     };
     let scene = scene(
         camera,
-        vec![
-            flat_triangle([corners[0], corners[2], corners[1]], 0),
-            flat_triangle([corners[0], corners[3], corners[2]], 0),
-        ],
+        floor_square(10.0, 0),
         vec![material("plane", rho, Vec3::ZERO)],
         vec![PointLight {
             position: light,

@@ -15,13 +15,6 @@ use igi_gpu::passes::display::{DisplayOptions, DisplayPass};
 use igi_gpu::{GpuContext, Renderer};
 
 fn plane_scene() -> (Scene, Camera) {
-    let s = 10.0;
-    let c = [
-        Vec3::new(-s, 0.0, -s),
-        Vec3::new(s, 0.0, -s),
-        Vec3::new(s, 0.0, s),
-        Vec3::new(-s, 0.0, s),
-    ];
     let camera = Camera {
         eye: Vec3::new(0.2, 2.0, 1.5),
         target: Vec3::ZERO,
@@ -30,10 +23,7 @@ fn plane_scene() -> (Scene, Camera) {
     };
     let scene = scene(
         camera,
-        vec![
-            flat_triangle([c[0], c[2], c[1]], 0),
-            flat_triangle([c[0], c[3], c[2]], 0),
-        ],
+        floor_square(10.0, 0),
         vec![material("plane", Vec3::splat(0.5), Vec3::ZERO)],
         vec![PointLight {
             position: Vec3::new(0.0, 1.0, 0.0),

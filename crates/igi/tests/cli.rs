@@ -1,41 +1,11 @@
 //! The `igi` command as a user meets it: bad input gives one clear error line naming the
 //! file (and line where known) and a non-zero exit, never a panic; good input renders.
 
+mod common;
+
+use common::{assert_one_error_line, igi, temp_dir};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
-
-fn igi(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_igi"))
-        .args(args)
-        .env(
-            "XDG_RUNTIME_DIR",
-            std::env::var("XDG_RUNTIME_DIR").unwrap_or("/tmp".into()),
-        )
-        .output()
-        .expect("run igi")
-}
-
-fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("igi-cli-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-/// The run failed with exactly one line on stderr that contains every `needle`.
-fn assert_one_error_line(out: &Output, needles: &[&str]) {
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(
-        !out.status.success(),
-        "expected failure, got success; stderr: {stderr}"
-    );
-    assert!(!stderr.contains("panicked"), "panic: {stderr}");
-    let lines: Vec<&str> = stderr.lines().filter(|l| l.starts_with("error")).collect();
-    assert_eq!(lines.len(), 1, "one error line expected, got: {stderr}");
-    for n in needles {
-        assert!(lines[0].contains(n), "'{}' does not name '{n}'", lines[0]);
-    }
-}
 
 const CAMERA: &str = "[camera]\neye = [0.0, 1.0, 3.0]\ntarget = [0.0, 1.0, 0.0]\nup = [0.0, 1.0, 0.0]\nfov_y_deg = 40.0\n[film]\nwidth = 16\nheight = 16\n";
 const LIGHT: &str = "[[point_light]]\nposition = [0.0, 1.5, 0.0]\nintensity = [1.0, 1.0, 1.0]\n";

@@ -4,22 +4,12 @@
 //! `igi render --accumulate N`, so the screenshot must be that very image. Where Xvfb is
 //! missing the window tests skip with a printed reason (`.ci/run` installs it).
 
+mod common;
+
+use common::{assert_one_error_line, igi, igi_command, temp_dir};
 use igi_core::image::{rel_mse, Image};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
-
-fn igi_command() -> Command {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_igi"));
-    c.env(
-        "XDG_RUNTIME_DIR",
-        std::env::var("XDG_RUNTIME_DIR").unwrap_or("/tmp".into()),
-    );
-    c
-}
-
-fn igi(args: &[&str]) -> Output {
-    igi_command().args(args).output().expect("run igi")
-}
 
 /// `igi ARGS` inside a fresh Xvfb display, or `None` (printed) when there is no xvfb-run.
 /// One at a time: `xvfb-run -a` picks a free display number racily.
@@ -44,13 +34,6 @@ fn igi_in_xvfb(args: &[&str]) -> Option<Output> {
         std::env::var("XDG_RUNTIME_DIR").unwrap_or("/tmp".into()),
     );
     Some(c.output().expect("run xvfb-run"))
-}
-
-fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("igi-view-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
 }
 
 fn succeeded(out: &Output, what: &str) {
@@ -199,18 +182,6 @@ fn camera_option_is_the_scene_files_camera() {
         0.0
     );
     std::fs::remove_dir_all(&dir).unwrap();
-}
-
-/// The run failed with one error line holding every needle, and no panic.
-fn assert_one_error_line(out: &Output, needles: &[&str]) {
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(!out.status.success(), "expected failure; stderr: {stderr}");
-    assert!(!stderr.contains("panicked"), "panic: {stderr}");
-    let lines: Vec<&str> = stderr.lines().filter(|l| l.starts_with("error")).collect();
-    assert_eq!(lines.len(), 1, "one error line expected, got: {stderr}");
-    for n in needles {
-        assert!(lines[0].contains(n), "'{}' does not name '{n}'", lines[0]);
-    }
 }
 
 #[test]

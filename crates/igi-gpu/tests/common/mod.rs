@@ -48,6 +48,20 @@ pub fn material(name: &str, diffuse: Vec3, mirror: Vec3) -> Material {
     }
 }
 
+/// The square [-half, half]^2 of the plane y = 0 as two triangles facing +y.
+pub fn floor_square(half: f32, material: u32) -> Vec<Triangle> {
+    let c = [
+        Vec3::new(-half, 0.0, -half),
+        Vec3::new(half, 0.0, -half),
+        Vec3::new(half, 0.0, half),
+        Vec3::new(-half, 0.0, half),
+    ];
+    vec![
+        flat_triangle([c[0], c[2], c[1]], material),
+        flat_triangle([c[0], c[3], c[2]], material),
+    ]
+}
+
 pub fn flat_triangle(v: [Vec3; 3], material: u32) -> Triangle {
     let n = (v[1] - v[0]).cross(v[2] - v[0]).normalize();
     Triangle {
