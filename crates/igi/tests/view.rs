@@ -224,3 +224,33 @@ fn bad_camera_and_options_are_one_clear_error() {
     ]);
     assert_one_error_line(&out, &["/no/such/dir"]);
 }
+
+/// Without --width/--height the image is the window less the panel, at 1/--scale.
+#[test]
+fn image_follows_the_window() {
+    let dir = temp_dir("follow");
+    let shot = dir.join("view.png");
+    let args = [
+        "view",
+        "--builtin",
+        "cornell-box",
+        "--vpls",
+        "8",
+        "--window",
+        "480x200",
+        "--scale",
+        "2",
+        "--frames",
+        "1",
+        "--screenshot",
+        shot.to_str().unwrap(),
+    ];
+    let Some(out) = igi_in_xvfb(&args) else {
+        return;
+    };
+    succeeded(&out, "igi view");
+    let panel = igi::view::PANEL_WIDTH as u32;
+    let (w, h, _) = png_pixels(&shot);
+    assert_eq!((w, h), ((480 - panel) / 2, 100));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
