@@ -41,13 +41,14 @@ impl IndirectPass {
         width: u32,
         height: u32,
         imperfect_visibility: bool,
+        vpls_per_pixel: u32,
         software: bool,
     ) -> [(&wgpu::ComputePipeline, [u32; 3]); 1] {
         [self.pipelines.step(
             width,
             height,
             imperfect_visibility,
-            super::lanes_for(width * height, software),
+            super::lanes_for(width * height, vpls_per_pixel, software),
         )]
     }
 }

@@ -106,14 +106,22 @@ pub const LANE_CHOICES: [u32; 3] = [1, 8, 32];
 
 /// Below this many pixels of the indirect term, each pixel's VPLs are split over 8 lanes:
 /// a downsampled 800 x 600 frame (30000 pixels) is a few hundred warps, far from filling
-/// a large GPU; full resolution (480000) fills it with one lane. `IGI_VPL_LANES` (1 or 8)
-/// overrides the choice, for measurements.
+/// a large GPU; full resolution (480000) fills it with one lane. `IGI_VPL_LANES` (1, 8 or
+/// 32) overrides the choice, for measurements.
 pub const LANES_BELOW_PIXELS: u32 = 200_000;
 
-/// The lanes a gathering pass uses over `pixels` pixels; always one
-/// on a software adapter, which has few threads to fill and whose workgroup barriers are
-/// slow.
-pub fn lanes_for(pixels: u32, software: bool) -> u32 {
+/// Below this many pixels, and from [`WIDE_LANES_FROM_VPLS`] VPLs per pixel on, 32 lanes:
+/// measured on the H200 (docs/PERFORMANCE.md, attempt 19), iv+ds at 800 x 600 (30000
+/// pixels, 188 VPLs each) gathers in 1.98 ms with 32 lanes against 2.45 with 8, while at
+/// 1920 x 1080 (130000 pixels) 8 lanes win (6.72 against 8.05 ms), and with interleaving
+/// (21 VPLs a pixel) 8 and 32 lanes tie.
+pub const WIDE_LANES_BELOW_PIXELS: u32 = 60_000;
+pub const WIDE_LANES_FROM_VPLS: u32 = 64;
+
+/// The lanes a gathering pass uses over `pixels` pixels gathering about `vpls_per_pixel`
+/// VPLs each; always one on a software adapter, which has few threads to fill and whose
+/// workgroup barriers are slow.
+pub fn lanes_for(pixels: u32, vpls_per_pixel: u32, software: bool) -> u32 {
     if let Some(l) = std::env::var("IGI_VPL_LANES")
         .ok()
         .and_then(|v| v.parse::<u32>().ok())
@@ -122,10 +130,12 @@ pub fn lanes_for(pixels: u32, software: bool) -> u32 {
             return l;
         }
     }
-    if pixels < LANES_BELOW_PIXELS && !software {
-        8
-    } else {
+    if software || pixels >= LANES_BELOW_PIXELS {
         1
+    } else if pixels < WIDE_LANES_BELOW_PIXELS && vpls_per_pixel >= WIDE_LANES_FROM_VPLS {
+        32
+    } else {
+        8
     }
 }
 
