@@ -1,5 +1,6 @@
 //! The frame (paper section 4): [`Renderer::encode_frame`] lists its passes in order —
-//! VPL shooting, direct + specular, indirect diffuse, compose — each a compute pass with
+//! VPL shooting, direct + specular, [mirror indirect and its filter], indirect diffuse,
+//! [its filters], compose — each a compute pass with
 //! its own timestamp pair. The renderer owns the scene on the GPU, the passes and the
 //! frame's buffers; nothing is read back inside a frame.
 
@@ -10,9 +11,10 @@ use crate::passes::direct::{DirectBindings, DirectPass};
 use crate::passes::display::DisplayInputs;
 use crate::passes::filter::{Filter, FilterPass};
 use crate::passes::indirect::IndirectPass;
-use crate::passes::mirror::MirrorPass;
 use crate::passes::vpl::VplPass;
-use crate::passes::{dispatch, gather_range_layout, GatherRanges, GATHER_RANGE_STRIDE};
+use crate::passes::{
+    dispatch, gather_range_layout, lanes_for, mirror_lanes, GatherRanges, GATHER_RANGE_STRIDE,
+};
 use crate::profiler::{Profiler, StageTime};
 use crate::scene_buffers::SceneBuffers;
 use igi_core::bvh::Bvh;
@@ -57,10 +59,12 @@ struct ImageBuffers {
     normal: wgpu::Buffer,
     geometric: wgpu::Buffer,
     albedo: wgpu::Buffer,
-    /// The first diffuse hit of each pixel's mirror chain: position, shading normal,
-    /// geometric normal, weight (mirror.wgsl).
+    /// The first diffuse hit of each pixel's mirror chain (direct.wgsl): position,
+    /// shading normal (w: the chain's length), geometric normal, weight (w = 1 where
+    /// there is one).
     mirror: [wgpu::Buffer; 4],
-    /// E at the mirrored hits (full resolution), as the mirror pass leaves it, and after
+    /// E at the mirrored hits (full resolution), as the mirror indirect stage leaves it,
+    /// and after
     /// the discontinuity buffer over the mirrored hits (interleaved frames).
     mirror_irradiance: wgpu::Buffer,
     mirror_filtered: wgpu::Buffer,
@@ -85,13 +89,12 @@ pub struct Renderer {
     vpl: VplPass,
     direct: DirectPass,
     indirect: IndirectPass,
-    mirror: MirrorPass,
     filter: FilterPass,
     compose: ComposePass,
     profiler: Profiler,
     params: wgpu::Buffer,
-    /// The frame's parameters as the discontinuity buffer over the mirrored hits reads
-    /// them: its image is the full-resolution one (no downsampling there).
+    /// The frame's parameters as the indirect pass and the discontinuity buffer read them
+    /// over the mirrored hits: their image is the full-resolution one (no downsampling).
     mirror_params: wgpu::Buffer,
     vpl_header: wgpu::Buffer,
     /// The scrambled Halton sequence's digit permutations, for the seed they were made for.
@@ -103,6 +106,7 @@ pub struct Renderer {
     images: Option<ImageBuffers>,
     vpl_buffers: Option<VplBuffers>,
     camera: Camera,
+    /// See [`light_powers`].
     light_power_sum: f32,
     total_power: [f32; 3],
     diagonal: f32,
@@ -156,7 +160,6 @@ impl Renderer {
             vpl: VplPass::new(device, layout),
             direct: DirectPass::new(device, layout, &range_layout),
             indirect: IndirectPass::new(device, layout, &range_layout),
-            mirror: MirrorPass::new(device, layout, &range_layout),
             range_layout,
             range_buffer: None,
             vpls_per_dispatch: ctx.vpls_per_dispatch(),
@@ -181,8 +184,8 @@ impl Renderer {
             images: None,
             vpl_buffers: None,
             camera: scene.camera,
-            light_power_sum: scene.lights.iter().map(|l| l.power().element_sum()).sum(),
-            total_power: scene.total_power().to_array(),
+            light_power_sum: light_powers(&scene.lights).0,
+            total_power: light_powers(&scene.lights).1,
             diagonal: scene.diagonal(),
             path_cache: None,
             counting: false,
@@ -217,12 +220,7 @@ impl Renderer {
         let gpu = crate::scene_buffers::gpu_lights(lights);
         ctx.queue
             .write_buffer(&self.scene.lights, 0, bytemuck::cast_slice(&gpu));
-        self.light_power_sum = lights.iter().map(|l| l.power().element_sum()).sum();
-        self.total_power = lights
-            .iter()
-            .map(|l| l.power())
-            .sum::<glam::Vec3>()
-            .to_array();
+        (self.light_power_sum, self.total_power) = light_powers(lights);
         self.path_cache = None;
         Ok(())
     }
@@ -852,16 +850,16 @@ impl Renderer {
         // Scenes without mirrors have no mirrored hits: no stage.
         let mut mirror_e = &img.mirror_irradiance;
         if self.has_mirrors {
-            let mirror_bind = self.mirror.bind(
+            // The indirect pass over the mirror record, at full resolution.
+            let mirror_bind = self.indirect.bind(
                 device,
                 &[
-                    &self.params,
+                    &self.mirror_params,
                     &vb.vpls,
                     &self.vpl_header,
                     &img.mirror[0],
                     &img.mirror[1],
                     &img.mirror[2],
-                    &img.mirror[3],
                     &img.mirror_irradiance,
                 ],
             );
@@ -871,7 +869,9 @@ impl Renderer {
                 p,
                 i,
                 "mirror indirect",
-                &self.mirror.steps(full.0, full.1, iv, self.software),
+                &self
+                    .indirect
+                    .steps(full.0, full.1, iv, mirror_lanes(self.software)),
                 scene,
                 &mirror_bind,
                 Some(&ranges),
@@ -925,8 +925,11 @@ impl Renderer {
                 low.0,
                 low.1,
                 iv,
-                settings.vpls / (a.interleave.0 * a.interleave.1).max(1),
-                self.software,
+                lanes_for(
+                    low.0 * low.1,
+                    settings.vpls / (a.interleave.0 * a.interleave.1).max(1),
+                    self.software,
+                ),
             ),
             scene,
             &indirect_bind,
@@ -987,6 +990,15 @@ impl Renderer {
         );
         stages
     }
+}
+
+/// What light choice and the VPLs' flux need of the lights: the sum over lights of each
+/// one's power summed over channels (in this order, as the CPU twin `igi_core::vpl`
+/// sums it), and the total power per channel.
+fn light_powers(lights: &[PointLight]) -> (f32, [f32; 3]) {
+    let sum = lights.iter().map(|l| l.power().element_sum()).sum();
+    let total = lights.iter().map(|l| l.power()).sum::<glam::Vec3>();
+    (sum, total.to_array())
 }
 
 /// The resolution of the indirect term: full / downsample, rounded up.

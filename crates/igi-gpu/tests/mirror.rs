@@ -1,7 +1,7 @@
 //! Whitted mirrors: the direct + specular buffer at pixels that see a mirror equals a CPU
 //! evaluation of the same chain (igi_core's BVH and the GPU's own VPL list): direct light
 //! at the mirror, plus the mirror's reflectance times direct and indirect light at the
-//! reflected hit, the indirect part gathered from the full VPL set (mirror.wgsl).
+//! reflected hit, the indirect part gathered from the full VPL set (the mirror indirect stage).
 
 mod common;
 

@@ -18,7 +18,7 @@ pub struct DirectBindings<'a> {
     pub normal: &'a wgpu::Buffer,
     pub geometric: &'a wgpu::Buffer,
     pub albedo: &'a wgpu::Buffer,
-    /// The mirrored-hit record (see mirror.wgsl).
+    /// The mirrored-hit record (gathered at by the mirror indirect stage, frame.rs).
     pub mirror: [&'a wgpu::Buffer; 4],
 }
 

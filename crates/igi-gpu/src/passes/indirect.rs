@@ -1,5 +1,9 @@
-//! Indirect diffuse light at the primary hits from all VPLs (paper section 4, third
-//! stage), stored as the incident term E without the albedo. See `shaders/indirect.wgsl`.
+//! Indirect diffuse light from the VPLs (paper section 4, third stage), stored as the
+//! incident term E without the albedo, at the records of a G-buffer: the primary hits
+//! (at the indirect term's resolution), and, with a second set of parameters at full
+//! resolution, the first diffuse hits seen through mirrors (the "mirror indirect" stage;
+//! the paper gathers every VPL there and leaves that cost as future work).
+//! See `shaders/indirect.wgsl`.
 
 use super::{bind, pass_layout, LanePipelines};
 use crate::scene_buffers::{READ, UNIFORM, WRITE};
@@ -35,20 +39,17 @@ impl IndirectPass {
         bind(device, "indirect", &self.layout, buffers)
     }
 
-    /// The dispatch over a `width` x `height` indirect term.
+    /// The dispatch over a `width` x `height` record, each pixel's VPLs split over
+    /// `lanes` threads (see [`super::lanes_for`] and [`super::mirror_lanes`]).
     pub fn steps(
         &self,
         width: u32,
         height: u32,
         imperfect_visibility: bool,
-        vpls_per_pixel: u32,
-        software: bool,
+        lanes: u32,
     ) -> [(&wgpu::ComputePipeline, [u32; 3]); 1] {
-        [self.pipelines.step(
-            width,
-            height,
-            imperfect_visibility,
-            super::lanes_for(width * height, vpls_per_pixel, software),
-        )]
+        [self
+            .pipelines
+            .step(width, height, imperfect_visibility, lanes)]
     }
 }

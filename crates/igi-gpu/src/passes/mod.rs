@@ -7,7 +7,6 @@ pub mod direct;
 pub mod display;
 pub mod filter;
 pub mod indirect;
-pub mod mirror;
 pub mod vpl;
 
 use crate::profiler::Profiler;
@@ -36,11 +35,6 @@ pub const SOURCES: &[PassSource] = &[
     PassSource {
         name: "indirect",
         wgsl: include_str!("../shaders/indirect.wgsl"),
-        gathers: true,
-    },
-    PassSource {
-        name: "mirror",
-        wgsl: include_str!("../shaders/mirror.wgsl"),
         gathers: true,
     },
     PassSource {
@@ -103,6 +97,27 @@ impl GatherPipelines {
 
 /// VPL lanes per pixel the gathering passes are built for (`VPL_LANES` of gather.wgsl).
 pub const LANE_CHOICES: [u32; 3] = [1, 8, 32];
+
+/// Lanes per pixel of the indirect pass at the mirrored hits (the mirror indirect stage): few pixels see a mirror (18000 of 480000 in the
+/// conference room), so their VPL loops are split over 8 threads; one lane on a software
+/// adapter. 8 beat 32 and 1 on the H200 at 800 x 600 and 1920 x 1080, canonical and
+/// interleaved (docs/PERFORMANCE.md, attempt 17). `IGI_MIRROR_LANES` (1, 8 or 32)
+/// overrides it, for measurements.
+pub fn mirror_lanes(software: bool) -> u32 {
+    if let Some(l) = std::env::var("IGI_MIRROR_LANES")
+        .ok()
+        .and_then(|v| v.parse::<u32>().ok())
+    {
+        if LANE_CHOICES.contains(&l) {
+            return l;
+        }
+    }
+    if software {
+        1
+    } else {
+        8
+    }
+}
 
 /// Below this many pixels of the indirect term, each pixel's VPLs are split over 8 lanes:
 /// a downsampled 800 x 600 frame (30000 pixels) is a few hundred warps, far from filling

@@ -11,7 +11,7 @@
 @group(1) @binding(4) var<storage, read_write> color_out: array<vec4<f32>>;
 @group(1) @binding(5) var<storage, read> gbuf_position: array<vec4<f32>>;
 @group(1) @binding(6) var<storage, read> gbuf_normal: array<vec4<f32>>;
-// Indirect light at the pixel's mirrored hit (mirror.wgsl): weight (w = 1 where there is
+// Indirect light at the pixel's mirrored hit (indirect.wgsl over the mirror record): weight (w = 1 where there is
 // one) times E there, after the mirror discontinuity filter when interleaved.
 @group(1) @binding(7) var<storage, read> mirror_weight: array<vec4<f32>>;
 @group(1) @binding(8) var<storage, read> mirror_irradiance: array<vec4<f32>>;

@@ -2,7 +2,7 @@
 // primary ray per pixel; at each hit the point lights add (rho_d / pi) I V cos / d^2, a
 // mirror part continues the Whitted tree up to the depth limit, and at hits reached
 // through mirrors the indirect diffuse term comes from the full VPL set (no screen-space
-// pass reaches them): at the first such hit it is gathered by mirror.wgsl from the
+// pass reaches them): at the first such hit it is gathered by indirect.wgsl from the
 // record written here (compose adds it), at any later one (a mirror seen in a mirror)
 // here. Writes the
 // G-buffer of the primary hit.
@@ -19,7 +19,9 @@
 @group(1) @binding(5) var<storage, read_write> gbuf_normal: array<vec4<f32>>;
 @group(1) @binding(6) var<storage, read_write> gbuf_geometric: array<vec4<f32>>;
 @group(1) @binding(7) var<storage, read_write> gbuf_albedo: array<vec4<f32>>;
-// The first diffuse hit of the pixel's mirror chain, for mirror.wgsl to gather at.
+// The first diffuse hit of the pixel's mirror chain, for the mirror indirect stage
+// (indirect.wgsl) to gather at. The shading normal's w is the chain's length (the
+// depth the mirror discontinuity buffer compares), the weight's w is 1 where there is one.
 @group(1) @binding(8) var<storage, read_write> mirror_position: array<vec4<f32>>;
 @group(1) @binding(9) var<storage, read_write> mirror_normal: array<vec4<f32>>;
 @group(1) @binding(10) var<storage, read_write> mirror_geometric: array<vec4<f32>>;

@@ -5,6 +5,11 @@
 // (section 4.2: one G-buffer sample stands for each block) and, with interleaved
 // sampling (section 4.3), each pixel gathers only its subset of the VPLs, scaled by the
 // number of subsets, so that the tile's average stays an unbiased estimate.
+// The same pass gathers at the hits seen through mirrors (the "mirror indirect" stage,
+// frame.rs): bound to the direct pass's mirror record instead of the G-buffer, with
+// parameters of full resolution (no downsampling), so that those hits are interleaved
+// too; the discontinuity buffer then runs over that record (filter.wgsl) and compose
+// adds weight x E. The paper gathers every VPL there and leaves the cost as future work.
 
 @group(1) @binding(1) var<storage, read> vpls: array<Vpl>;
 @group(1) @binding(2) var<storage, read> vpl_header: VplHeader;

@@ -437,7 +437,7 @@ impl Viewer {
         self.stats.accumulated = self.accumulated;
         self.stats.image = (width, height);
 
-        self.present(&output.shapes, output.textures_delta, ppp, viewport)?;
+        self.present(output.shapes, output.textures_delta, ppp, viewport)?;
         self.ctx.check()?;
         // The time this redraw took: frame, readbacks, panel and present.
         let wall_ms = now.elapsed().as_secs_f64() * 1e3;
@@ -500,7 +500,7 @@ impl Viewer {
     /// The display pass and the panel into the window's next texture.
     fn present(
         &mut self,
-        shapes: &[egui::epaint::ClippedShape],
+        shapes: Vec<egui::epaint::ClippedShape>,
         mut textures: egui::TexturesDelta,
         ppp: f32,
         viewport: [f32; 4],
@@ -538,7 +538,8 @@ impl Viewer {
             b: 0.02,
             a: 1.0,
         };
-        if let Some(inputs) = self.renderer.display_inputs() {
+        let inputs = self.renderer.display_inputs();
+        if let Some(inputs) = &inputs {
             let options = DisplayOptions {
                 viewport: clip_to(viewport, self.config.width, self.config.height),
                 exposure: self.state.settings.exposure,
@@ -546,9 +547,9 @@ impl Viewer {
                 background,
             };
             self.display
-                .draw(device, queue, &mut encoder, &view, &inputs, &options);
+                .draw(device, queue, &mut encoder, &view, inputs, &options);
         }
-        let primitives = self.egui_ctx.tessellate(shapes.to_vec(), ppp);
+        let primitives = self.egui_ctx.tessellate(shapes, ppp);
         let screen = egui_wgpu::ScreenDescriptor {
             size_in_pixels: [self.config.width, self.config.height],
             pixels_per_point: ppp,
@@ -565,7 +566,7 @@ impl Viewer {
                         depth_slice: None,
                         resolve_target: None,
                         ops: wgpu::Operations {
-                            load: if self.renderer.display_inputs().is_some() {
+                            load: if inputs.is_some() {
                                 wgpu::LoadOp::Load
                             } else {
                                 wgpu::LoadOp::Clear(background)
