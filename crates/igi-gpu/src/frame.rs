@@ -1,8 +1,9 @@
 //! The frame (paper section 4): [`Renderer::encode_frame`] lists its passes in order —
-//! VPL shooting, direct + specular, [mirror indirect and its filter], indirect diffuse,
-//! [its filters], compose — each a compute pass with
-//! its own timestamp pair. The renderer owns the scene on the GPU, the passes and the
-//! frame's buffers; nothing is read back inside a frame.
+//! VPL shooting beside direct + specular, the VPL list, [the mirror chains], [mirror
+//! indirect and its filter], indirect diffuse, [its filters], compose — each a compute
+//! pass with its own timestamp pair (VPL shooting and direct + specular share one). The
+//! renderer owns the scene on the GPU, the passes and the frame's buffers; nothing is
+//! read back inside a frame.
 
 use crate::context::{GpuContext, GpuError, SMALLER_FRAME};
 use crate::layout::{FrameParams, Vpl};
@@ -13,7 +14,8 @@ use crate::passes::filter::{Filter, FilterPass};
 use crate::passes::indirect::IndirectPass;
 use crate::passes::vpl::VplPass;
 use crate::passes::{
-    dispatch, gather_range_layout, lanes_for, mirror_lanes, GatherRanges, GATHER_RANGE_STRIDE,
+    dispatch, dispatch_together, gather_range_layout, lanes_for, mirror_lanes, Dispatches,
+    GatherRanges, GATHER_RANGE_STRIDE,
 };
 use crate::profiler::{Profiler, StageTime};
 use crate::scene_buffers::SceneBuffers;
@@ -25,9 +27,10 @@ use igi_core::settings::{
     Accelerations, FilterMode, GeometryBound, InterleavePattern, OutputBuffer, RenderSettings,
 };
 
-/// Most stages a frame can have (vpl, direct, mirror indirect, mirror discontinuity,
-/// indirect, two filters, compose), each with its timestamp pair.
-pub const MAX_STAGES: u32 = 8;
+/// Most stages a frame can have (VPL shooting, direct, VPL list, mirror chains, mirror
+/// indirect, mirror discontinuity, indirect, two filters, compose), each with its
+/// timestamp pair.
+pub const MAX_STAGES: u32 = 10;
 
 /// Light paths of the pilot run that estimates VPLs per path.
 pub const PILOT_PATHS: u32 = 4096;
@@ -97,6 +100,10 @@ pub struct Renderer {
     /// over the mirrored hits: their image is the full-resolution one (no downsampling).
     mirror_params: wgpu::Buffer,
     vpl_header: wgpu::Buffer,
+    /// An empty VPL list and header bound to the direct pass's first walk, which gathers
+    /// nothing: binding the real ones (written by VPL shooting) would put a barrier
+    /// between the two passes, which are meant to run side by side.
+    no_vpls: (wgpu::Buffer, wgpu::Buffer),
     /// The scrambled Halton sequence's digit permutations, for the seed they were made for.
     halton_perms: (u32, wgpu::Buffer),
     /// Bind group 2 of the gathering passes: the VPL ranges of one frame.
@@ -180,6 +187,10 @@ impl Renderer {
                 mapped_at_creation: false,
             }),
             vpl_header: storage(device, "vpl header", 16),
+            no_vpls: (
+                storage(device, "no vpls", std::mem::size_of::<Vpl>() as u64),
+                storage(device, "no vpl header", 16),
+            ),
             halton_perms: (0, permutation_buffer(ctx, 0)),
             images: None,
             vpl_buffers: None,
@@ -383,7 +394,8 @@ impl Renderer {
     }
 
     /// Write the VPL ranges for a frame of `slots` VPL slots (an upper bound of the VPL
-    /// count, which only the GPU knows) and return how many there are.
+    /// count, which only the GPU knows) and return how many there are. Entry 0 is the
+    /// direct pass's first walk (no VPLs, `first_walk` = 1), entries 1..=count the ranges.
     fn ensure_ranges(&mut self, ctx: &GpuContext, slots: u64) -> u32 {
         let per = self.vpls_per_dispatch as u64;
         let count = slots.div_ceil(per).max(1) as u32;
@@ -393,12 +405,13 @@ impl Renderer {
             .is_none_or(|(_, _, n)| *n != count)
         {
             let stride = GATHER_RANGE_STRIDE as usize;
-            let mut bytes = vec![0u8; count as usize * stride];
+            let mut bytes = vec![0u8; (count as usize + 1) * stride];
+            bytes[..12].copy_from_slice(bytemuck::cast_slice(&[0u32, 0, 1]));
             for i in 0..count as usize {
                 let begin = (i as u64 * per).min(u32::MAX as u64) as u32;
                 let end = ((i as u64 + 1) * per).min(u32::MAX as u64) as u32;
-                bytes[i * stride..i * stride + 8]
-                    .copy_from_slice(bytemuck::cast_slice(&[begin, end]));
+                let at = (i + 1) * stride;
+                bytes[at..at + 12].copy_from_slice(bytemuck::cast_slice(&[begin, end, 0]));
             }
             let buffer = wgpu::util::DeviceExt::create_buffer_init(
                 &ctx.device,
@@ -775,8 +788,10 @@ impl Renderer {
         let scene = &self.scene.bind_group;
         let p = &self.profiler;
         let (_, range_group, range_count) = self.range_buffer.as_ref().expect("ranges written");
+        // Entry 0 of the range buffer is the direct pass's first walk, then the VPL ranges.
         let ranges = GatherRanges {
             bind_group: range_group,
+            first: 1,
             count: *range_count,
         };
         let a = &settings.accelerations;
@@ -789,6 +804,11 @@ impl Renderer {
             stages.len() as u32 - 1
         };
 
+        // VPL shooting and the direct pass's first walk share no buffer that either
+        // writes, so no barrier keeps them apart: the light paths (a few workgroups that
+        // each walk up to `bounces` closest hits in sequence, latency more than work)
+        // run beside the direct pass instead of before it. Shooting goes first, so that
+        // its workgroups start before the direct pass's fill the GPU.
         let vpl_bind = self.vpl.bind(
             device,
             &self.params,
@@ -797,57 +817,94 @@ impl Renderer {
             &self.vpl_header,
             &self.halton_perms.1,
         );
-        let i = stage("vpl shooting");
+        let [shoot, compact] = self.vpl.steps(paths);
+        let direct_bind = |vpls: &wgpu::Buffer, header: &wgpu::Buffer| {
+            self.direct.bind(
+                device,
+                &self.params,
+                DirectBindings {
+                    vpls,
+                    vpl_header: header,
+                    direct: &img.direct,
+                    position: &img.position,
+                    normal: &img.normal,
+                    geometric: &img.geometric,
+                    albedo: &img.albedo,
+                    mirror: [
+                        &img.mirror[0],
+                        &img.mirror[1],
+                        &img.mirror[2],
+                        &img.mirror[3],
+                    ],
+                },
+            )
+        };
+        // A frame that counts rays counts them all in one buffer (then with a barrier).
+        let beside = if self.counting {
+            scene
+        } else {
+            &self.scene.beside_bind_group
+        };
+        let first_walk = GatherRanges {
+            bind_group: range_group,
+            first: 0,
+            count: 1,
+        };
+        let direct_first = direct_bind(&self.no_vpls.0, &self.no_vpls.1);
+        let direct_steps = self.direct.steps(full.0, full.1, iv);
+        let i = stage("vpl shooting + direct");
+        dispatch_together(
+            encoder,
+            p,
+            i,
+            "vpl shooting + direct",
+            &[
+                Dispatches {
+                    steps: &[shoot],
+                    scene,
+                    pass: &vpl_bind,
+                    ranges: None,
+                },
+                Dispatches {
+                    steps: &direct_steps,
+                    scene: beside,
+                    pass: &direct_first,
+                    ranges: Some(&first_walk),
+                },
+            ],
+        );
+
+        let i = stage("vpl list");
         dispatch(
             encoder,
             p,
             i,
-            "vpl shooting",
-            &self.vpl.steps(paths),
+            "vpl list",
+            &[compact],
             scene,
             &vpl_bind,
             None,
         );
 
-        let direct_bind = self.direct.bind(
-            device,
-            &self.params,
-            DirectBindings {
-                vpls: &vb.vpls,
-                vpl_header: &self.vpl_header,
-                direct: &img.direct,
-                position: &img.position,
-                normal: &img.normal,
-                geometric: &img.geometric,
-                albedo: &img.albedo,
-                mirror: [
-                    &img.mirror[0],
-                    &img.mirror[1],
-                    &img.mirror[2],
-                    &img.mirror[3],
-                ],
-            },
-        );
-        // Ranges after the first only add indirect light at hits seen in a mirror seen in
-        // a mirror: without mirrors the first range does all there is (on llvmpipe each
-        // further dispatch still costs ~25 ms at 40K pixels, even when every pixel returns).
-        let direct_ranges = GatherRanges {
-            bind_group: range_group,
-            count: if self.has_mirrors { *range_count } else { 1 },
-        };
-        let i = stage("direct + specular");
-        dispatch(
-            encoder,
-            p,
-            i,
-            "direct + specular",
-            &self.direct.steps(full.0, full.1, iv),
-            scene,
-            &direct_bind,
-            Some(&direct_ranges),
-        );
+        // Hits seen in a mirror seen in a mirror gather their VPLs in later walks of the
+        // direct pass, over the chains its first walk flagged.
+        if self.has_mirrors && settings.mirror_depth >= 2 {
+            let i = stage("mirror chains");
+            dispatch(
+                encoder,
+                p,
+                i,
+                "mirror chains",
+                &self.direct.steps(full.0, full.1, iv),
+                scene,
+                &direct_bind(&vb.vpls, &self.vpl_header),
+                Some(&ranges),
+            );
+        }
 
-        // Scenes without mirrors have no mirrored hits: no stage.
+        // Scenes without mirrors have no mirrored hits: no stage. (Run side by side with
+        // the indirect stage, in one compute pass, the two took as long as one after the
+        // other: both fill the GPU. docs/PERFORMANCE.md, attempt 22.)
         let mut mirror_e = &img.mirror_irradiance;
         if self.has_mirrors {
             // The indirect pass over the mirror record, at full resolution.

@@ -9,6 +9,11 @@ use igi_core::scene::Scene;
 pub struct SceneBuffers {
     pub layout: wgpu::BindGroupLayout,
     pub bind_group: wgpu::BindGroup,
+    /// The same scene with spare ray counters, for a pass that runs beside another one in
+    /// a frame that counts nothing (the direct pass beside VPL shooting): wgpu keeps two
+    /// dispatches that bind one read-write buffer apart by a barrier, even when neither
+    /// writes it.
+    pub beside_bind_group: wgpu::BindGroup,
     pub light_count: u32,
     /// The point lights (binding 4), rewritten when the viewer moves a light.
     pub lights: wgpu::Buffer,
@@ -143,25 +148,31 @@ impl SceneBuffers {
         ];
         let bytes = buffers.iter().map(|b| b.size()).sum();
         let ray_counters = storage_buffer(ctx, "ray counters", &[0u8; 32])?;
+        let spare_counters = storage_buffer(ctx, "spare ray counters", &[0u8; 32])?;
         let layout = Self::layout(&ctx.device);
-        let entries: Vec<wgpu::BindGroupEntry> = buffers
-            .iter()
-            .chain([&ray_counters])
-            .enumerate()
-            .map(|(i, b)| wgpu::BindGroupEntry {
-                binding: i as u32,
-                resource: b.as_entire_binding(),
+        let group = |label: &str, counters: &wgpu::Buffer| {
+            let entries: Vec<wgpu::BindGroupEntry> = buffers
+                .iter()
+                .chain([counters])
+                .enumerate()
+                .map(|(i, b)| wgpu::BindGroupEntry {
+                    binding: i as u32,
+                    resource: b.as_entire_binding(),
+                })
+                .collect();
+            ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some(label),
+                layout: &layout,
+                entries: &entries,
             })
-            .collect();
-        let bind_group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("scene"),
-            layout: &layout,
-            entries: &entries,
-        });
+        };
+        let bind_group = group("scene", &ray_counters);
+        let beside_bind_group = group("scene (spare ray counters)", &spare_counters);
         let [_, _, _, _, lights_buffer] = buffers;
         Ok(SceneBuffers {
             layout,
             bind_group,
+            beside_bind_group,
             light_count: lights.len() as u32,
             lights: lights_buffer,
             ray_counters,

@@ -41,12 +41,131 @@ fn primary_dir(cam: &Camera, width: u32, height: u32, x: u32, y: u32) -> Vec3 {
     (forward + sx * right + sy * up).normalize()
 }
 
+/// Irradiance at a surface point from the lights and (optionally) the VPLs, on the CPU
+/// with the GPU's formulas; `m` is the bounding distance of G.
+#[allow(clippy::too_many_arguments)]
+fn irradiance(
+    scene: &Scene,
+    bvh: &Bvh,
+    vpls: &[igi_gpu::layout::Vpl],
+    m: f32,
+    p: Vec3,
+    ng: Vec3,
+    ns: Vec3,
+    with_vpls: bool,
+) -> Vec3 {
+    let origin = offset_ray_origin(p, ng);
+    let mut e = Vec3::ZERO;
+    for l in &scene.lights {
+        let d = l.position - p;
+        let cos = ns.dot(d) / d.length();
+        if cos > 0.0 && ng.dot(d) > 0.0 && !bvh.trace_any(origin, l.position - origin, 1.0) {
+            e += l.intensity * cos / d.length_squared();
+        }
+    }
+    if with_vpls {
+        for v in vpls {
+            let (y, ny) = (Vec3::from(v.position), Vec3::from(v.normal));
+            let d = y - p;
+            let dist2 = d.length_squared();
+            let dist = dist2.sqrt();
+            let (cx, cy) = (ns.dot(d) / dist, -ny.dot(d) / dist);
+            if cx <= 0.0 || cy <= 0.0 || ng.dot(d) <= 0.0 {
+                continue;
+            }
+            let t = ((dist - 0.8 * m) / (0.4 * m)).clamp(0.0, 1.0);
+            let g = cx * cy * t * t * (3.0 - 2.0 * t) / dist2;
+            let end = offset_ray_origin(y, ny);
+            if g > 0.0 && !bvh.trace_any(origin, end - origin, 1.0) {
+                e += Vec3::from(v.flux) * Vec3::from(v.albedo) * (g / PI);
+            }
+        }
+    }
+    e
+}
+
+/// What the direct + specular buffer holds at pixel (x, y), evaluated on the CPU along the
+/// pixel's mirror chain (Whitted, up to `settings.mirror_depth` reflections): light at
+/// every diffuse hit, and the full VPL gather at every hit seen through a mirror. Returns
+/// that and the number of hits seen through mirrors that gathered (0: not a mirror pixel).
+fn chain_radiance(
+    scene: &Scene,
+    bvh: &Bvh,
+    vpls: &[igi_gpu::layout::Vpl],
+    settings: &RenderSettings,
+    x: u32,
+    y: u32,
+) -> (Vec3, u32) {
+    let m = settings.min_dist_for(scene);
+    let cam = scene.camera;
+    let mut dir = primary_dir(&cam, settings.width, settings.height, x, y);
+    let mut origin = cam.eye;
+    let mut throughput = Vec3::ONE;
+    let (mut radiance, mut gathered) = (Vec3::ZERO, 0);
+    for depth in 0..=settings.mirror_depth {
+        let Some(hit) = bvh.trace_closest(origin, dir, f32::INFINITY) else {
+            break;
+        };
+        let s = surface_at(scene, bvh, dir, hit.tri, hit.u, hit.v);
+        if s.diffuse.max_element() > 0.0 {
+            let e = irradiance(
+                scene,
+                bvh,
+                vpls,
+                m,
+                s.position,
+                s.geometric_normal,
+                s.shading_normal,
+                depth > 0,
+            );
+            radiance += throughput * s.diffuse / PI * e;
+            gathered += u32::from(depth > 0);
+        }
+        if s.mirror.max_element() <= 0.0 {
+            break;
+        }
+        throughput *= s.mirror;
+        dir = reflect(dir, s.shading_normal);
+        if dir.dot(s.geometric_normal) <= 0.0 {
+            dir = reflect(dir, s.geometric_normal);
+        }
+        origin = offset_ray_origin(s.position, s.geometric_normal);
+    }
+    (radiance, gathered)
+}
+
+/// Renders the direct + specular buffer of `scene` and compares every pixel whose chain
+/// gathers at a hit seen through a mirror with [`chain_radiance`]; returns (pixels
+/// checked, pixels whose chain gathered at two hits or more, pixels off by > 0.1%).
+fn check_chains(scene: &Scene, settings: &RenderSettings) -> Option<(u32, u32, u32)> {
+    let ctx = gpu()?;
+    let bvh = Bvh::build(&scene.triangles);
+    let mut renderer = Renderer::new(&ctx, scene, &bvh).unwrap();
+    let frame = renderer.render(&ctx, settings).unwrap();
+    let vpls = renderer.read_vpls(&ctx).unwrap();
+    assert!(!vpls.is_empty());
+    let (mut checked, mut chained, mut off) = (0, 0, 0);
+    for y in 0..settings.height {
+        for x in 0..settings.width {
+            let (expected, gathered) = chain_radiance(scene, &bvh, &vpls, settings, x, y);
+            if gathered == 0 {
+                continue;
+            }
+            checked += 1;
+            chained += u32::from(gathered >= 2);
+            let got = Vec3::from(frame.image.pixel(x, y));
+            if ((got - expected).abs() / expected.max(Vec3::splat(1e-3))).max_element() > 1e-3 {
+                off += 1;
+            }
+        }
+    }
+    Some((checked, chained, off))
+}
+
 #[test]
 fn mirrored_hits_gather_from_all_vpls() {
-    let Some(ctx) = gpu() else { return };
     // The floor becomes half mirror, half diffuse.
     let scene = mirror_floor(Vec3::splat(0.3), Vec3::splat(0.5));
-    let bvh = Bvh::build(&scene.triangles);
     let settings = RenderSettings {
         width: 48,
         height: 48,
@@ -55,78 +174,61 @@ fn mirrored_hits_gather_from_all_vpls() {
         output: OutputBuffer::Direct,
         ..RenderSettings::for_scene(&scene)
     };
-    let mut renderer = Renderer::new(&ctx, &scene, &bvh).unwrap();
-    let frame = renderer.render(&ctx, &settings).unwrap();
-    let vpls = renderer.read_vpls(&ctx).unwrap();
-    assert!(!vpls.is_empty());
-    let m = settings.min_dist_for(&scene);
-
-    // Irradiance at a surface point from the lights and (optionally) the VPLs, on the CPU.
-    let irradiance = |p: Vec3, ng: Vec3, ns: Vec3, with_vpls: bool| -> Vec3 {
-        let origin = offset_ray_origin(p, ng);
-        let mut e = Vec3::ZERO;
-        for l in &scene.lights {
-            let d = l.position - p;
-            let cos = ns.dot(d) / d.length();
-            if cos > 0.0 && ng.dot(d) > 0.0 && !bvh.trace_any(origin, l.position - origin, 1.0) {
-                e += l.intensity * cos / d.length_squared();
-            }
-        }
-        if with_vpls {
-            for v in &vpls {
-                let (y, ny) = (Vec3::from(v.position), Vec3::from(v.normal));
-                let d = y - p;
-                let dist2 = d.length_squared();
-                let dist = dist2.sqrt();
-                let (cx, cy) = (ns.dot(d) / dist, -ny.dot(d) / dist);
-                if cx <= 0.0 || cy <= 0.0 || ng.dot(d) <= 0.0 {
-                    continue;
-                }
-                let t = ((dist - 0.8 * m) / (0.4 * m)).clamp(0.0, 1.0);
-                let g = cx * cy * t * t * (3.0 - 2.0 * t) / dist2;
-                let end = offset_ray_origin(y, ny);
-                if g > 0.0 && !bvh.trace_any(origin, end - origin, 1.0) {
-                    e += Vec3::from(v.flux) * Vec3::from(v.albedo) * (g / PI);
-                }
-            }
-        }
-        e
+    let Some((checked, _, off)) = check_chains(&scene, &settings) else {
+        return;
     };
-
-    let cam = scene.camera;
-    let (mut checked, mut off) = (0, 0);
-    for y in 0..settings.height {
-        for x in 0..settings.width {
-            let dir = primary_dir(&cam, settings.width, settings.height, x, y);
-            let Some(hit) = bvh.trace_closest(cam.eye, dir, f32::INFINITY) else {
-                continue;
-            };
-            let s = surface_at(&scene, &bvh, dir, hit.tri, hit.u, hit.v);
-            if s.mirror.max_element() <= 0.0 {
-                continue;
-            }
-            let mut expected = s.diffuse / PI
-                * irradiance(s.position, s.geometric_normal, s.shading_normal, false);
-            let rdir = reflect(dir, s.shading_normal);
-            let origin = offset_ray_origin(s.position, s.geometric_normal);
-            if let Some(h2) = bvh.trace_closest(origin, rdir, f32::INFINITY) {
-                let s2 = surface_at(&scene, &bvh, rdir, h2.tri, h2.u, h2.v);
-                expected += s.mirror * s2.diffuse / PI
-                    * irradiance(s2.position, s2.geometric_normal, s2.shading_normal, true);
-            }
-            let got = Vec3::from(frame.image.pixel(x, y));
-            checked += 1;
-            if ((got - expected).abs() / expected.max(Vec3::splat(1e-3))).max_element() > 1e-3 {
-                off += 1;
-            }
-        }
-    }
     eprintln!("{checked} mirror pixels, {off} off by more than 0.1%");
     assert!(
         checked > 200,
         "the floor should fill the bottom of the image: {checked}"
     );
     // A shadow ray grazing an edge may decide differently on the GPU; a few, no more.
+    assert!(
+        off * 100 <= checked,
+        "{off} of {checked} mirror pixels differ"
+    );
+}
+
+/// A mirror seen in a mirror: floor, ceiling and back wall all half mirror, so that
+/// chains go floor -> back wall -> ...; the hits after the first one seen through a mirror
+/// gather their VPLs in the direct pass's later walks (after VPL shooting, which its first
+/// walk runs beside).
+#[test]
+fn hits_seen_in_a_mirror_seen_in_a_mirror_gather_from_all_vpls() {
+    let mut scene = mirror_floor(Vec3::splat(0.3), Vec3::splat(0.5));
+    let floor_material = scene.materials.len() as u32 - 1;
+    let corners = scene.triangles.iter().flat_map(|t| t.v);
+    let top = corners.clone().map(|v| v.y).fold(f32::MIN, f32::max);
+    // The back wall: the plane of constant z farthest from the eye.
+    let eye_z = scene.camera.eye.z;
+    let back = corners
+        .map(|v| v.z)
+        .max_by(|a, b| (a - eye_z).abs().total_cmp(&(b - eye_z).abs()))
+        .unwrap();
+    for t in &mut scene.triangles {
+        let on = |f: &dyn Fn(Vec3) -> bool| t.v.iter().all(|&v| f(v));
+        if on(&|v| (v.y - top).abs() < 1e-3) || on(&|v| (v.z - back).abs() < 1e-3) {
+            t.material = floor_material;
+        }
+    }
+    let settings = RenderSettings {
+        width: 48,
+        height: 48,
+        vpls: 60,
+        mirror_depth: 3,
+        output: OutputBuffer::Direct,
+        ..RenderSettings::for_scene(&scene)
+    };
+    let Some((checked, chained, off)) = check_chains(&scene, &settings) else {
+        return;
+    };
+    eprintln!(
+        "{checked} mirror pixels, {chained} gathering at two hits or more, {off} off by more than 0.1%"
+    );
+    assert!(
+        chained > 100,
+        "floor, ceiling and back wall should reflect each other: {chained}"
+    );
     assert!(
         off * 100 <= checked,
         "{off} of {checked} mirror pixels differ"

@@ -222,8 +222,8 @@ fn bench_runs_tiny_and_its_json_parses() {
     assert_eq!(
         names,
         [
-            "vpl shooting",
-            "direct + specular",
+            "vpl shooting + direct",
+            "vpl list",
             "indirect",
             "discontinuity",
             "upsample",

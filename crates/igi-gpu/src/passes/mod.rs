@@ -313,11 +313,22 @@ pub fn gather_range_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     })
 }
 
-/// The gather ranges of a frame: bind group 2 of the gathering passes, and how many
-/// ranges (dispatches) each of them takes.
+/// Some entries of a frame's gather-range buffer (bind group 2 of the gathering passes):
+/// `count` dispatches, from entry `first` on.
 pub struct GatherRanges<'a> {
     pub bind_group: &'a wgpu::BindGroup,
+    pub first: u32,
     pub count: u32,
+}
+
+/// What one compute pass runs for one pass of the frame: each step's pipeline over its
+/// workgroups, with the scene's and the pass's bind groups; with `ranges`, every step runs
+/// once per VPL range (bind group 2).
+pub(crate) struct Dispatches<'a> {
+    pub steps: &'a [(&'a wgpu::ComputePipeline, [u32; 3])],
+    pub scene: &'a wgpu::BindGroup,
+    pub pass: &'a wgpu::BindGroup,
+    pub ranges: Option<&'a GatherRanges<'a>>,
 }
 
 /// One compute pass with its own timestamp pair, running each step's pipeline over its
@@ -333,21 +344,50 @@ pub(crate) fn dispatch(
     pass: &wgpu::BindGroup,
     ranges: Option<&GatherRanges>,
 ) {
+    dispatch_together(
+        encoder,
+        profiler,
+        stage,
+        label,
+        &[Dispatches {
+            steps,
+            scene,
+            pass,
+            ranges,
+        }],
+    );
+}
+
+/// The dispatches of several passes in one compute pass (one timestamp pair), run side by
+/// side: wgpu records each compute pass into a command buffer of its own, and the GPU
+/// does not run work of two command buffers at once (measured on the H200,
+/// docs/PERFORMANCE.md attempt 21), while two dispatches of one pass that share no
+/// written buffer get no barrier between them (wgpu puts one before a dispatch only when
+/// one of its buffers changes state).
+pub(crate) fn dispatch_together(
+    encoder: &mut wgpu::CommandEncoder,
+    profiler: &Profiler,
+    stage: u32,
+    label: &str,
+    parts: &[Dispatches],
+) {
     let mut cpass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
         label: Some(label),
         timestamp_writes: profiler.pass_writes(stage),
     });
-    cpass.set_bind_group(0, scene, &[]);
-    cpass.set_bind_group(1, pass, &[]);
-    for (pipeline, groups) in steps {
-        cpass.set_pipeline(pipeline);
-        match ranges {
-            None => cpass.dispatch_workgroups(groups[0], groups[1], groups[2]),
-            Some(r) => {
-                for i in 0..r.count {
-                    let offset = (i as u64 * GATHER_RANGE_STRIDE) as u32;
-                    cpass.set_bind_group(2, r.bind_group, &[offset]);
-                    cpass.dispatch_workgroups(groups[0], groups[1], groups[2]);
+    for part in parts {
+        cpass.set_bind_group(0, part.scene, &[]);
+        cpass.set_bind_group(1, part.pass, &[]);
+        for (pipeline, groups) in part.steps {
+            cpass.set_pipeline(pipeline);
+            match part.ranges {
+                None => cpass.dispatch_workgroups(groups[0], groups[1], groups[2]),
+                Some(r) => {
+                    for i in r.first..r.first + r.count {
+                        let offset = (i as u64 * GATHER_RANGE_STRIDE) as u32;
+                        cpass.set_bind_group(2, r.bind_group, &[offset]);
+                        cpass.dispatch_workgroups(groups[0], groups[1], groups[2]);
+                    }
                 }
             }
         }

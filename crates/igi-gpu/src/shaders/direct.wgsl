@@ -4,11 +4,13 @@
 // through mirrors the indirect diffuse term comes from the full VPL set (no screen-space
 // pass reaches them): at the first such hit it is gathered by indirect.wgsl from the
 // record written here (compose adds it), at any later one (a mirror seen in a mirror)
-// here. Writes the
-// G-buffer of the primary hit.
-// When the VPL list is gathered in several ranges (see gather.wgsl), the first dispatch
-// does everything and later ones walk the mirror chain again, adding only their range's
-// indirect light at mirrored hits.
+// here. Writes the G-buffer of the primary hit.
+// The pass walks twice. Its first walk gathers no VPLs, so that it can run beside VPL
+// shooting, before any VPL exists (frame.rs: the two are not kept apart by a barrier); it
+// does everything else and flags the pixels whose chain has hits seen in a mirror seen in
+// a mirror (albedo w = 2). Later walks, after VPL shooting, follow only those chains again
+// and add the VPL light of their range (one range on GPUs, several on llvmpipe, see
+// gather.wgsl) at those hits.
 
 @group(1) @binding(1) var<storage, read> vpls: array<Vpl>;
 @group(1) @binding(2) var<storage, read> vpl_header: VplHeader;
@@ -37,8 +39,8 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     var dir = camera_ray_dir(gid.x, gid.y);
     var throughput = vec3<f32>(1.0);
     var radiance = vec3<f32>(0.0);
-    let first_range = gather_first() == 0u;
-    if (first_range) {
+    let first_walk = gather_range.first_walk != 0u;
+    if (first_walk) {
         gbuf_position[pixel] = vec4<f32>(0.0);
         gbuf_normal[pixel] = vec4<f32>(0.0);
         gbuf_geometric[pixel] = vec4<f32>(0.0);
@@ -46,14 +48,16 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         mirror_position[pixel] = vec4<f32>(0.0);
         mirror_weight[pixel] = vec4<f32>(0.0);
     } else {
-        // Later ranges only add light at mirrored hits: nothing to do without a mirror.
-        if (gbuf_albedo[pixel].w == 0.0) {
+        // Later walks only add VPL light at hits seen in a mirror seen in a mirror.
+        if (gbuf_albedo[pixel].w < 2.0) {
             return;
         }
         radiance = direct_out[pixel].xyz;
     }
     var traced = 0u;
     var recorded = false;
+    // Whether the chain reaches a hit seen in a mirror seen in a mirror (first walk).
+    var chained = false;
     // Length of the chain so far: the mirrored hit's depth for the mirror filter.
     var travelled = 0.0;
     for (var depth = 0u; depth <= params.mirror_depth; depth += 1u) {
@@ -64,30 +68,34 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         }
         let s = surface_at(origin, dir, hit);
         travelled += hit.t;
-        if (depth == 0u && first_range) {
+        if (depth == 0u && first_walk) {
             gbuf_position[pixel] = vec4<f32>(s.position, 1.0);
             gbuf_normal[pixel] = vec4<f32>(s.shading_normal, hit.t);
             gbuf_geometric[pixel] = vec4<f32>(s.geometric_normal, 0.0);
-            // w: 1 where the pixel's mirror chain goes on (see the later ranges above).
+            // w: 1 where the pixel's mirror chain goes on, 2 where it needs later walks.
             let mirrored = max(s.mirror.x, max(s.mirror.y, s.mirror.z)) > 0.0;
             gbuf_albedo[pixel] = vec4<f32>(s.diffuse, select(0.0, 1.0, mirrored));
         }
         if (max(s.diffuse.x, max(s.diffuse.y, s.diffuse.z)) > 0.0) {
             var e = vec3<f32>(0.0);
-            if (first_range) {
+            if (first_walk) {
                 e = direct_irradiance(s.position, s.geometric_normal, s.shading_normal);
             }
             let weight = throughput * s.diffuse / PI;
             if (depth > 0u && !recorded) {
                 recorded = true;
-                if (first_range) {
+                if (first_walk) {
                     mirror_position[pixel] = vec4<f32>(s.position, 1.0);
                     mirror_normal[pixel] = vec4<f32>(s.shading_normal, travelled);
                     mirror_geometric[pixel] = vec4<f32>(s.geometric_normal, 0.0);
                     mirror_weight[pixel] = vec4<f32>(weight, 1.0);
                 }
             } else if (depth > 0u) {
-                e += vpl_irradiance(s.position, s.geometric_normal, s.shading_normal, gather_first(), gather_last(), 1u);
+                if (first_walk) {
+                    chained = true;
+                } else {
+                    e += vpl_irradiance(s.position, s.geometric_normal, s.shading_normal, gather_first(), gather_last(), 1u);
+                }
             }
             radiance += weight * e;
         }
@@ -101,9 +109,12 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         }
         origin = offset_ray_origin(s.position, s.geometric_normal);
     }
-    if (first_range) {
+    if (first_walk) {
         count_rays(RAY_PRIMARY, 1u);
         count_rays(RAY_MIRROR, traced - 1u);
+        if (chained) {
+            gbuf_albedo[pixel].w = 2.0;
+        }
     }
     direct_out[pixel] = vec4<f32>(radiance, 1.0);
 }

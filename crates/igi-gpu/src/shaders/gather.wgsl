@@ -17,7 +17,9 @@ override IMPERFECT_VISIBILITY: bool = false;
 struct GatherRange {
     begin: u32,
     end: u32,
-    _pad0: u32,
+    // The direct pass only (direct.wgsl): 1 in its first walk, which gathers no VPLs, 0 in
+    // its later walks, which add the range's VPLs at hits seen in a mirror seen in a mirror.
+    first_walk: u32,
     _pad1: u32,
 }
 
