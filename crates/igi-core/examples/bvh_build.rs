@@ -96,20 +96,37 @@ fn main() {
     let tan = (cam.fov_y_deg.to_radians() * 0.5).tan();
     let aspect = w as f32 / h as f32;
     let t = Instant::now();
-    let mut hits = 0usize;
+    let mut hit_points = vec![];
     for y in 0..h {
         for x in 0..w {
             let px = (2.0 * (x as f32 + 0.5) / w as f32 - 1.0) * tan * aspect;
             let py = (1.0 - 2.0 * (y as f32 + 0.5) / h as f32) * tan;
             let d: Vec3 = (fwd + px * right + py * up).normalize();
-            hits += usize::from(bvh.trace_closest(cam.eye, d, f32::INFINITY).is_some());
+            if let Some(hit) = bvh.trace_closest(cam.eye, d, f32::INFINITY) {
+                hit_points.push(cam.eye + d * hit.t);
+            }
         }
     }
     let secs = t.elapsed().as_secs_f64();
     println!(
         "CPU closest hit, {w}x{h} camera rays on one thread: {:.2} Mrays/s, {:.1}% hit",
         (w * h) as f64 / secs / 1e6,
-        100.0 * hits as f64 / (w * h) as f64
+        100.0 * hit_points.len() as f64 / (w * h) as f64
+    );
+    // Shadow rays from those hits to the lights (pulled back a little from the surface).
+    let t = Instant::now();
+    let (mut rays, mut occluded) = (0usize, 0usize);
+    for p in &hit_points {
+        for l in &scene.lights {
+            let o = *p + (cam.eye - *p).normalize() * 1e-3;
+            occluded += usize::from(bvh.trace_any(o, l.position - o, 1.0));
+            rays += 1;
+        }
+    }
+    println!(
+        "CPU any hit, {rays} shadow rays from those hits to the lights on one thread: {:.2} Mrays/s, {:.1}% occluded",
+        rays as f64 / t.elapsed().as_secs_f64() / 1e6,
+        100.0 * occluded as f64 / rays as f64
     );
 }
 

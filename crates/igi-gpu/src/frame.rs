@@ -71,6 +71,10 @@ struct ImageBuffers {
     /// the discontinuity buffer over the mirrored hits (interleaved frames).
     mirror_irradiance: wgpu::Buffer,
     mirror_filtered: wgpu::Buffer,
+    /// The pixels with a mirrored hit (direct.wgsl's mirror_list: two counters, then one
+    /// u32 per pixel), and the workgroup counts of the mirror indirect stage's dispatch.
+    mirror_list: wgpu::Buffer,
+    mirror_args: wgpu::Buffer,
     /// E at the indirect resolution, as the indirect pass leaves it.
     irradiance: wgpu::Buffer,
     /// After the discontinuity buffer (indirect resolution).
@@ -166,7 +170,12 @@ impl Renderer {
         let renderer = Renderer {
             vpl: VplPass::new(device, layout),
             direct: DirectPass::new(device, layout, &range_layout),
-            indirect: IndirectPass::new(device, layout, &range_layout),
+            indirect: IndirectPass::new(
+                device,
+                layout,
+                &range_layout,
+                mirror_lanes(ctx.info.device_type == wgpu::DeviceType::Cpu),
+            ),
             range_layout,
             range_buffer: None,
             vpls_per_dispatch: ctx.vpls_per_dispatch(),
@@ -295,6 +304,8 @@ impl Renderer {
                 &b.mirror_irradiance,
                 &b.mirror_filtered,
                 &b.color,
+                &b.mirror_list,
+                &b.mirror_args,
             ]
             .iter()
             .map(|b| b.size())
@@ -335,10 +346,11 @@ impl Renderer {
         }
         self.images = None;
         let size = width as u64 * height as u64 * 16;
+        let list_size = (2 + width as u64 * height as u64) * 4;
         let device = &ctx.device;
         let images = ctx.allocate(
             || format!("the {IMAGE_BUFFERS} frame buffers of a {width}x{height} image"),
-            IMAGE_BUFFERS as u64 * size.max(16),
+            IMAGE_BUFFERS as u64 * size.max(16) + list_size,
             SMALLER_FRAME,
             || ImageBuffers {
                 width,
@@ -360,6 +372,13 @@ impl Renderer {
                 filtered_low: storage(device, "irradiance after discontinuity", size),
                 filtered: storage(device, "irradiance full resolution", size),
                 color: storage(device, "color", size),
+                mirror_list: storage(device, "mirror list", list_size),
+                mirror_args: device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("mirror indirect dispatch"),
+                    size: 16,
+                    usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT,
+                    mapped_at_creation: false,
+                }),
             },
         )?;
         self.images = Some(images);
@@ -836,6 +855,7 @@ impl Renderer {
                         &img.mirror[2],
                         &img.mirror[3],
                     ],
+                    mirror_list: &img.mirror_list,
                 },
             )
         };
@@ -864,27 +884,65 @@ impl Renderer {
                     scene,
                     pass: &vpl_bind,
                     ranges: None,
+                    group3: None,
+                    indirect: None,
                 },
                 Dispatches {
                     steps: &direct_steps,
                     scene: beside,
                     pass: &direct_first,
                     ranges: Some(&first_walk),
+                    group3: None,
+                    indirect: None,
                 },
             ],
         );
 
-        let i = stage("vpl list");
-        dispatch(
-            encoder,
-            p,
-            i,
-            "vpl list",
-            &[compact],
-            scene,
-            &vpl_bind,
-            None,
+        // The indirect pass over the mirror record (the mirror indirect stage below),
+        // gathering only at the pixels the direct pass listed.
+        let mirror_bind = self.indirect.bind(
+            device,
+            &[
+                &self.mirror_params,
+                &vb.vpls,
+                &self.vpl_header,
+                &img.mirror[0],
+                &img.mirror[1],
+                &img.mirror[2],
+                &img.mirror_irradiance,
+            ],
         );
+        let (list_bind, args_bind) =
+            self.indirect
+                .bind_list(device, &img.mirror_list, &img.mirror_args);
+        let one_range = GatherRanges {
+            bind_group: range_group,
+            first: 1,
+            count: 1,
+        };
+        let args_step = [self.indirect.args_step()];
+        let compact_step = [compact];
+        let mut list_parts = vec![Dispatches {
+            steps: &compact_step,
+            scene,
+            pass: &vpl_bind,
+            ranges: None,
+            group3: None,
+            indirect: None,
+        }];
+        if self.has_mirrors {
+            // Sizes the mirror indirect dispatch from the list's length.
+            list_parts.push(Dispatches {
+                steps: &args_step,
+                scene,
+                pass: &mirror_bind,
+                ranges: Some(&one_range),
+                group3: Some(&args_bind),
+                indirect: None,
+            });
+        }
+        let i = stage("vpl list");
+        dispatch_together(encoder, p, i, "vpl list", &list_parts);
 
         // Hits seen in a mirror seen in a mirror gather their VPLs in later walks of the
         // direct pass, over the chains its first walk flagged.
@@ -907,31 +965,21 @@ impl Renderer {
         // other: both fill the GPU. docs/PERFORMANCE.md, attempt 22.)
         let mut mirror_e = &img.mirror_irradiance;
         if self.has_mirrors {
-            // The indirect pass over the mirror record, at full resolution.
-            let mirror_bind = self.indirect.bind(
-                device,
-                &[
-                    &self.mirror_params,
-                    &vb.vpls,
-                    &self.vpl_header,
-                    &img.mirror[0],
-                    &img.mirror[1],
-                    &img.mirror[2],
-                    &img.mirror_irradiance,
-                ],
-            );
+            let (list_pipeline, _) = self.indirect.list_pipeline(iv);
             let i = stage("mirror indirect");
-            dispatch(
+            dispatch_together(
                 encoder,
                 p,
                 i,
                 "mirror indirect",
-                &self
-                    .indirect
-                    .steps(full.0, full.1, iv, mirror_lanes(self.software)),
-                scene,
-                &mirror_bind,
-                Some(&ranges),
+                &[Dispatches {
+                    steps: &[(list_pipeline, [0, 0, 0])],
+                    scene,
+                    pass: &mirror_bind,
+                    ranges: Some(&ranges),
+                    group3: Some(&list_bind),
+                    indirect: Some(&img.mirror_args),
+                }],
             );
             // Interleaved mirrored hits: the discontinuity buffer over their own record.
             if a.interleave.0 * a.interleave.1 > 1 {

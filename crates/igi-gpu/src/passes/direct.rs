@@ -20,6 +20,8 @@ pub struct DirectBindings<'a> {
     pub albedo: &'a wgpu::Buffer,
     /// The mirrored-hit record (gathered at by the mirror indirect stage, frame.rs).
     pub mirror: [&'a wgpu::Buffer; 4],
+    /// The list of pixels with a mirrored hit.
+    pub mirror_list: &'a wgpu::Buffer,
 }
 
 impl DirectPass {
@@ -33,6 +35,7 @@ impl DirectPass {
             "direct",
             &[
                 UNIFORM, READ, READ, WRITE, WRITE, WRITE, WRITE, WRITE, WRITE, WRITE, WRITE, WRITE,
+                WRITE,
             ],
         );
         DirectPass {
@@ -70,6 +73,7 @@ impl DirectPass {
                 b.mirror[1],
                 b.mirror[2],
                 b.mirror[3],
+                b.mirror_list,
             ],
         )
     }

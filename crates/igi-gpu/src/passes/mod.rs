@@ -329,6 +329,11 @@ pub(crate) struct Dispatches<'a> {
     pub scene: &'a wgpu::BindGroup,
     pub pass: &'a wgpu::BindGroup,
     pub ranges: Option<&'a GatherRanges<'a>>,
+    /// Bind group 3, for the pipelines that have one.
+    pub group3: Option<&'a wgpu::BindGroup>,
+    /// Workgroup counts read from this buffer (an indirect dispatch) instead of the
+    /// steps' own.
+    pub indirect: Option<&'a wgpu::Buffer>,
 }
 
 /// One compute pass with its own timestamp pair, running each step's pipeline over its
@@ -354,6 +359,8 @@ pub(crate) fn dispatch(
             scene,
             pass,
             ranges,
+            group3: None,
+            indirect: None,
         }],
     );
 }
@@ -378,15 +385,22 @@ pub(crate) fn dispatch_together(
     for part in parts {
         cpass.set_bind_group(0, part.scene, &[]);
         cpass.set_bind_group(1, part.pass, &[]);
+        if let Some(g) = part.group3 {
+            cpass.set_bind_group(3, g, &[]);
+        }
         for (pipeline, groups) in part.steps {
             cpass.set_pipeline(pipeline);
-            match part.ranges {
+            let run = |cpass: &mut wgpu::ComputePass| match part.indirect {
+                Some(args) => cpass.dispatch_workgroups_indirect(args, 0),
                 None => cpass.dispatch_workgroups(groups[0], groups[1], groups[2]),
+            };
+            match part.ranges {
+                None => run(&mut cpass),
                 Some(r) => {
                     for i in r.first..r.first + r.count {
                         let offset = (i as u64 * GATHER_RANGE_STRIDE) as u32;
                         cpass.set_bind_group(2, r.bind_group, &[offset]);
-                        cpass.dispatch_workgroups(groups[0], groups[1], groups[2]);
+                        run(&mut cpass);
                     }
                 }
             }

@@ -59,3 +59,46 @@ fn main_lanes(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation
         store_irradiance(p.x, p.y, lanes_total(l));
     }
 }
+
+// The mirror indirect stage over the list of mirrored pixels (direct.wgsl's mirror_list):
+// about one pixel in twenty sees a mirror in the conference room, and a dispatch over the
+// whole image spent most of its workgroups on pixels with nothing to gather.
+@group(3) @binding(0) var<storage, read_write> mirror_list: array<u32>;
+// Workgroups of main_list (x, y, z), for dispatch_workgroups_indirect.
+@group(3) @binding(1) var<storage, read_write> mirror_args: array<u32>;
+
+// Largest workgroup count of one dispatch dimension.
+const MAX_GROUPS: u32 = 65535u;
+
+// One thread: takes this frame's count of mirrored pixels, resets the counter for the next
+// frame and sizes main_list's dispatch (VPL_LANES threads per pixel, 64 per workgroup).
+@compute @workgroup_size(1)
+fn mirror_args_main() {
+    let n = mirror_list[0];
+    mirror_list[0] = 0u;
+    mirror_list[1] = n;
+    let groups = (n * VPL_LANES + 63u) / 64u;
+    let x = min(groups, MAX_GROUPS);
+    mirror_args[0] = x;
+    mirror_args[1] = select(0u, (groups + x - 1u) / max(x, 1u), x > 0u);
+    mirror_args[2] = 1u;
+}
+
+// main_lanes over the listed pixels: VPL_LANES neighbouring threads per pixel.
+@compute @workgroup_size(64)
+fn main_list(@builtin(workgroup_id) group: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>, @builtin(local_invocation_index) l: u32) {
+    let slot = ((group.x + group.y * groups.x) * 64u + l) / VPL_LANES;
+    let lane = l % VPL_LANES;
+    let inside = slot < mirror_list[1];
+    var pixel = 0u;
+    var sum = vec3<f32>(0.0);
+    if (inside) {
+        pixel = mirror_list[2u + slot];
+        sum = pixel_sum(pixel % params.low_width, pixel / params.low_width, lane, VPL_LANES);
+    }
+    lane_sums[l] = vec4<f32>(sum, 0.0);
+    workgroupBarrier();
+    if (inside && lane == 0u) {
+        store_irradiance(pixel % params.low_width, pixel / params.low_width, lanes_total(l));
+    }
+}
