@@ -207,6 +207,13 @@ impl GpuContext {
         let mut features = wgpu::Features::empty();
         if timestamps {
             features |= wgpu::Features::TIMESTAMP_QUERY;
+            // Stage timestamps between the dispatches of one compute pass (passes::Recorder).
+            if adapter
+                .features()
+                .contains(wgpu::Features::TIMESTAMP_QUERY_INSIDE_PASSES)
+            {
+                features |= wgpu::Features::TIMESTAMP_QUERY_INSIDE_PASSES;
+            }
         }
         let desc = wgpu::DeviceDescriptor {
             label: Some("igi"),

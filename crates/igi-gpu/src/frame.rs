@@ -14,8 +14,8 @@ use crate::passes::filter::{Filter, FilterPass};
 use crate::passes::indirect::IndirectPass;
 use crate::passes::vpl::VplPass;
 use crate::passes::{
-    dispatch, dispatch_together, gather_range_layout, lanes_for, mirror_lanes, Dispatches,
-    GatherRanges, GATHER_RANGE_STRIDE,
+    dispatch, gather_range_layout, lanes_for, mirror_lanes, Dispatches, GatherRanges, Recorder,
+    GATHER_RANGE_STRIDE,
 };
 use crate::profiler::{Profiler, StageTime};
 use crate::scene_buffers::SceneBuffers;
@@ -805,7 +805,7 @@ impl Renderer {
         let img = self.images.as_ref().expect("image buffers allocated");
         let vb = self.vpl_buffers.as_ref().expect("vpl buffers allocated");
         let scene = &self.scene.bind_group;
-        let p = &self.profiler;
+        let mut rec = Recorder::new(encoder, &self.profiler, "frame");
         let (_, range_group, range_count) = self.range_buffer.as_ref().expect("ranges written");
         // Entry 0 of the range buffer is the direct pass's first walk, then the VPL ranges.
         let ranges = GatherRanges {
@@ -873,9 +873,7 @@ impl Renderer {
         let direct_first = direct_bind(&self.no_vpls.0, &self.no_vpls.1);
         let direct_steps = self.direct.steps(full.0, full.1, iv);
         let i = stage("vpl shooting + direct");
-        dispatch_together(
-            encoder,
-            p,
+        rec.stage(
             i,
             "vpl shooting + direct",
             &[
@@ -942,15 +940,13 @@ impl Renderer {
             });
         }
         let i = stage("vpl list");
-        dispatch_together(encoder, p, i, "vpl list", &list_parts);
+        rec.stage(i, "vpl list", &list_parts);
 
         // Hits seen in a mirror seen in a mirror gather their VPLs in later walks of the
         // direct pass, over the chains its first walk flagged.
         if self.has_mirrors && settings.mirror_depth >= 2 {
             let i = stage("mirror chains");
-            dispatch(
-                encoder,
-                p,
+            rec.dispatch(
                 i,
                 "mirror chains",
                 &self.direct.steps(full.0, full.1, iv),
@@ -967,9 +963,7 @@ impl Renderer {
         if self.has_mirrors {
             let (list_pipeline, _) = self.indirect.list_pipeline(iv);
             let i = stage("mirror indirect");
-            dispatch_together(
-                encoder,
-                p,
+            rec.stage(
                 i,
                 "mirror indirect",
                 &[Dispatches {
@@ -994,9 +988,7 @@ impl Renderer {
                     ],
                 );
                 let i = stage("mirror discontinuity");
-                dispatch(
-                    encoder,
-                    p,
+                rec.dispatch(
                     i,
                     "mirror discontinuity",
                     &self.filter.steps(Filter::Discontinuity, full, full),
@@ -1021,9 +1013,7 @@ impl Renderer {
             ],
         );
         let i = stage("indirect");
-        dispatch(
-            encoder,
-            p,
+        rec.dispatch(
             i,
             "indirect",
             &self.indirect.steps(
@@ -1055,9 +1045,7 @@ impl Renderer {
                 .filter
                 .bind(device, &[&self.params, &img.position, &img.normal, e, out]);
             let i = stage(filter.stage_name());
-            dispatch(
-                encoder,
-                p,
+            rec.dispatch(
                 i,
                 filter.stage_name(),
                 &self.filter.steps(filter, full, low),
@@ -1083,9 +1071,7 @@ impl Renderer {
             ],
         );
         let i = stage("compose");
-        dispatch(
-            encoder,
-            p,
+        rec.dispatch(
             i,
             "compose",
             &self.compose.steps(full.0, full.1),

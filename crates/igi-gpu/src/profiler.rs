@@ -14,6 +14,8 @@ pub struct Profiler {
     query_set: Option<wgpu::QuerySet>,
     resolve: Option<wgpu::Buffer>,
     capacity: u32,
+    /// Whether timestamps can be written inside a compute pass (between its dispatches).
+    inside_passes: bool,
 }
 
 impl Profiler {
@@ -24,6 +26,7 @@ impl Profiler {
                 query_set: None,
                 resolve: None,
                 capacity: stages,
+                inside_passes: true,
             };
         }
         let count = 2 * stages;
@@ -42,6 +45,28 @@ impl Profiler {
             query_set: Some(query_set),
             resolve: Some(resolve),
             capacity: stages,
+            inside_passes: ctx
+                .device
+                .features()
+                .contains(wgpu::Features::TIMESTAMP_QUERY_INSIDE_PASSES),
+        }
+    }
+
+    /// Whether stages can share one compute pass and still be timed one by one (also
+    /// true when nothing is timed).
+    pub fn writes_inside_passes(&self) -> bool {
+        self.inside_passes
+    }
+
+    /// Write timestamp `index` between two dispatches of `cpass`.
+    pub fn write_inside(&self, cpass: &mut wgpu::ComputePass, index: u32) {
+        assert!(
+            index < 2 * self.capacity,
+            "profiler has room for {} stages",
+            self.capacity
+        );
+        if let Some(qs) = &self.query_set {
+            cpass.write_timestamp(qs, index);
         }
     }
 
@@ -105,7 +130,8 @@ impl Profiler {
         Profiler {
             query_set: None,
             resolve: None,
-            capacity: u32::MAX,
+            capacity: u32::MAX / 2,
+            inside_passes: true,
         }
     }
 }

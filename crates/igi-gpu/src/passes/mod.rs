@@ -382,6 +382,10 @@ pub(crate) fn dispatch_together(
         label: Some(label),
         timestamp_writes: profiler.pass_writes(stage),
     });
+    record(&mut cpass, parts);
+}
+
+fn record(cpass: &mut wgpu::ComputePass, parts: &[Dispatches]) {
     for part in parts {
         cpass.set_bind_group(0, part.scene, &[]);
         cpass.set_bind_group(1, part.pass, &[]);
@@ -395,16 +399,93 @@ pub(crate) fn dispatch_together(
                 None => cpass.dispatch_workgroups(groups[0], groups[1], groups[2]),
             };
             match part.ranges {
-                None => run(&mut cpass),
+                None => run(cpass),
                 Some(r) => {
                     for i in r.first..r.first + r.count {
                         let offset = (i as u64 * GATHER_RANGE_STRIDE) as u32;
                         cpass.set_bind_group(2, r.bind_group, &[offset]);
-                        run(&mut cpass);
+                        run(cpass);
                     }
                 }
             }
         }
+    }
+}
+
+/// Where a frame's stages are recorded: all in one compute pass, with each stage's
+/// timestamp pair written inside it, where the device can (or where nothing is timed),
+/// else one compute pass per stage. wgpu turns every compute pass into command buffers
+/// of its own, and on the H200 each boundary cost a few microseconds of idle GPU
+/// (docs/PERFORMANCE.md, attempt 25); inside one pass wgpu still puts a barrier before
+/// every dispatch that needs one. `IGI_STAGE_PASSES=1` forces a pass per stage, for
+/// measurements.
+pub(crate) struct Recorder<'a> {
+    encoder: &'a mut wgpu::CommandEncoder,
+    profiler: &'a Profiler,
+    /// The frame's one compute pass, when stages share one.
+    pass: Option<wgpu::ComputePass<'static>>,
+}
+
+impl<'a> Recorder<'a> {
+    pub(crate) fn new(
+        encoder: &'a mut wgpu::CommandEncoder,
+        profiler: &'a Profiler,
+        label: &str,
+    ) -> Recorder<'a> {
+        let one_pass = profiler.writes_inside_passes()
+            && std::env::var("IGI_STAGE_PASSES").as_deref() != Ok("1");
+        let pass = one_pass.then(|| {
+            encoder
+                .begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some(label),
+                    timestamp_writes: None,
+                })
+                .forget_lifetime()
+        });
+        Recorder {
+            encoder,
+            profiler,
+            pass,
+        }
+    }
+
+    /// Stage `stage`: the dispatches of `parts`, between its two timestamps.
+    pub(crate) fn stage(&mut self, stage: u32, label: &str, parts: &[Dispatches]) {
+        match &mut self.pass {
+            Some(cpass) => {
+                self.profiler.write_inside(cpass, 2 * stage);
+                cpass.push_debug_group(label);
+                record(cpass, parts);
+                cpass.pop_debug_group();
+                self.profiler.write_inside(cpass, 2 * stage + 1);
+            }
+            None => dispatch_together(self.encoder, self.profiler, stage, label, parts),
+        }
+    }
+
+    /// Stage `stage` with one pass's dispatches (see [`Dispatches`]).
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn dispatch(
+        &mut self,
+        stage: u32,
+        label: &str,
+        steps: &[(&wgpu::ComputePipeline, [u32; 3])],
+        scene: &wgpu::BindGroup,
+        pass: &wgpu::BindGroup,
+        ranges: Option<&GatherRanges>,
+    ) {
+        self.stage(
+            stage,
+            label,
+            &[Dispatches {
+                steps,
+                scene,
+                pass,
+                ranges,
+                group3: None,
+                indirect: None,
+            }],
+        );
     }
 }
 
