@@ -125,7 +125,7 @@ pub struct Renderer {
     path_cache: Option<((u32, u32, u32, u32), u32)>,
     /// Whether any material has a mirror part (else the mirror stage is skipped).
     has_mirrors: bool,
-    /// Whether the adapter is a software one (see `passes::indirect::lanes_for`).
+    /// Whether the adapter is a software one (see `passes::lanes_for`).
     software: bool,
     /// Whether the next frame counts its rays (see [`Renderer::count_rays`]).
     counting: bool,
@@ -1020,11 +1020,8 @@ impl Renderer {
                 low.0,
                 low.1,
                 iv,
-                lanes_for(
-                    low.0 * low.1,
-                    settings.vpls / (a.interleave.0 * a.interleave.1).max(1),
-                    self.software,
-                ),
+                lanes_for(low.0 * low.1, self.software),
+                a.interleave,
             ),
             scene,
             &indirect_bind,

@@ -98,17 +98,19 @@ impl IndirectPass {
         bind(device, "indirect", &self.layout, buffers)
     }
 
-    /// The dispatch over a `width` x `height` record, each pixel's VPLs split over
-    /// `lanes` threads (see [`super::lanes_for`] and [`super::mirror_lanes`]).
+    /// The dispatch over a `width` x `height` record interleaved in tiles of
+    /// `interleave` pixels, each pixel's VPLs split over `lanes` threads (see
+    /// [`super::lanes_for`]).
     pub fn steps(
         &self,
         width: u32,
         height: u32,
         imperfect_visibility: bool,
         lanes: u32,
+        interleave: (u32, u32),
     ) -> [(&wgpu::ComputePipeline, [u32; 3]); 1] {
         [self
             .pipelines
-            .step(width, height, imperfect_visibility, lanes)]
+            .step(width, height, imperfect_visibility, lanes, interleave)]
     }
 }

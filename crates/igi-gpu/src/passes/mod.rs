@@ -95,20 +95,25 @@ impl GatherPipelines {
     }
 }
 
-/// VPL lanes per pixel the gathering passes are built for (`VPL_LANES` of gather.wgsl).
-pub const LANE_CHOICES: [u32; 3] = [1, 8, 32];
+/// VPL lanes per pixel the indirect pass is built for: `main` (one) and `main_coherent`.
+pub const LANE_CHOICES: [u32; 2] = [1, COHERENT_LANES];
 
-/// Lanes per pixel of the indirect pass at the mirrored hits (the mirror indirect stage): few pixels see a mirror (18000 of 480000 in the
+/// The lanes per pixel of `main_coherent` (indirect.wgsl): a warp holds one lane of 32
+/// pixels of one interleaving subset.
+pub const COHERENT_LANES: u32 = 8;
+
+/// Lanes per pixel of the indirect pass at the mirrored hits (the mirror indirect stage,
+/// over the list of those pixels): few pixels see a mirror (18000 of 480000 in the
 /// conference room), so their VPL loops are split over 8 threads; one lane on a software
 /// adapter. 8 beat 32 and 1 on the H200 at 800 x 600 and 1920 x 1080, canonical and
-/// interleaved (docs/PERFORMANCE.md, attempt 17). `IGI_MIRROR_LANES` (1, 8 or 32)
-/// overrides it, for measurements.
+/// interleaved (docs/PERFORMANCE.md, attempts 17 and 26). `IGI_MIRROR_LANES` (1, 8 or
+/// 32) overrides it, for measurements.
 pub fn mirror_lanes(software: bool) -> u32 {
     if let Some(l) = std::env::var("IGI_MIRROR_LANES")
         .ok()
         .and_then(|v| v.parse::<u32>().ok())
     {
-        if LANE_CHOICES.contains(&l) {
+        if [1, 8, 32].contains(&l) {
             return l;
         }
     }
@@ -119,24 +124,19 @@ pub fn mirror_lanes(software: bool) -> u32 {
     }
 }
 
-/// Below this many pixels of the indirect term, each pixel's VPLs are split over 8 lanes:
-/// a downsampled 800 x 600 frame (30000 pixels) is a few hundred warps, far from filling
-/// a large GPU; full resolution (480000) fills it with one lane. `IGI_VPL_LANES` (1, 8 or
-/// 32) overrides the choice, for measurements.
-pub const LANES_BELOW_PIXELS: u32 = 200_000;
+/// Below this many pixels of the indirect term each pixel's VPLs are split over 8 lanes
+/// (`main_coherent`, a warp holding one lane of 32 pixels of one interleaving subset).
+/// Measured on the H200 (docs/PERFORMANCE.md, attempt 27): 8 lanes beat one lane from the
+/// downsampled frames (30000 pixels at 800 x 600) up to the full 800 x 600 frame (480000
+/// pixels: canonical indirect 22.1 -> 17.4 ms; one lane per pixel is under two waves of
+/// workgroups there, ending in a long tail), and lose a little at the full 1920 x 1080
+/// frame (2.07 M pixels: 64.7 against 63.7 ms). `IGI_VPL_LANES` (1 or 8) overrides the
+/// choice, for measurements.
+pub const LANES_BELOW_PIXELS: u32 = 1_000_000;
 
-/// Below this many pixels, and from [`WIDE_LANES_FROM_VPLS`] VPLs per pixel on, 32 lanes:
-/// measured on the H200 (docs/PERFORMANCE.md, attempt 19), iv+ds at 800 x 600 (30000
-/// pixels, 188 VPLs each) gathers in 1.98 ms with 32 lanes against 2.45 with 8, while at
-/// 1920 x 1080 (130000 pixels) 8 lanes win (6.72 against 8.05 ms), and with interleaving
-/// (21 VPLs a pixel) 8 and 32 lanes tie.
-pub const WIDE_LANES_BELOW_PIXELS: u32 = 60_000;
-pub const WIDE_LANES_FROM_VPLS: u32 = 64;
-
-/// The lanes a gathering pass uses over `pixels` pixels gathering about `vpls_per_pixel`
-/// VPLs each; always one on a software adapter, which has few threads to fill and whose
-/// workgroup barriers are slow.
-pub fn lanes_for(pixels: u32, vpls_per_pixel: u32, software: bool) -> u32 {
+/// The lanes a gathering pass uses over `pixels` pixels; always one on a software
+/// adapter, which has few threads to fill and whose workgroup barriers are slow.
+pub fn lanes_for(pixels: u32, software: bool) -> u32 {
     if let Some(l) = std::env::var("IGI_VPL_LANES")
         .ok()
         .and_then(|v| v.parse::<u32>().ok())
@@ -147,16 +147,14 @@ pub fn lanes_for(pixels: u32, vpls_per_pixel: u32, software: bool) -> u32 {
     }
     if software || pixels >= LANES_BELOW_PIXELS {
         1
-    } else if pixels < WIDE_LANES_BELOW_PIXELS && vpls_per_pixel >= WIDE_LANES_FROM_VPLS {
-        32
     } else {
-        8
+        COHERENT_LANES
     }
 }
 
 /// A gathering pass built for each entry of [`LANE_CHOICES`]: entry point `main` (one
-/// thread per pixel, 8 x 8 per workgroup) and `main_lanes` (64 threads per workgroup,
-/// VPL_LANES per pixel), each with and without imperfect visibility.
+/// thread per pixel, 8 x 8 per workgroup) and `main_coherent` (8 lanes per pixel, 256
+/// threads per workgroup), each with and without imperfect visibility.
 pub(crate) struct LanePipelines {
     by_lanes: Vec<GatherPipelines>,
 }
@@ -171,40 +169,36 @@ impl LanePipelines {
             by_lanes: LANE_CHOICES
                 .iter()
                 .map(|&lanes| {
-                    if lanes == 1 {
-                        GatherPipelines::new(device, name, "main", layouts, &[])
-                    } else {
-                        GatherPipelines::new(
-                            device,
-                            name,
-                            "main_lanes",
-                            layouts,
-                            &[("VPL_LANES", lanes as f64)],
-                        )
-                    }
+                    let entry = if lanes == 1 { "main" } else { "main_coherent" };
+                    GatherPipelines::new(device, name, entry, layouts, &[])
                 })
                 .collect(),
         }
     }
 
     /// The dispatch over `width` x `height` pixels with `lanes` lanes per pixel (one of
-    /// [`LANE_CHOICES`]).
+    /// [`LANE_CHOICES`]), interleaved in tiles of `interleave` pixels.
     pub(crate) fn step(
         &self,
         width: u32,
         height: u32,
         imperfect_visibility: bool,
         lanes: u32,
+        interleave: (u32, u32),
     ) -> (&wgpu::ComputePipeline, [u32; 3]) {
         let index = LANE_CHOICES.iter().position(|&l| l == lanes).unwrap_or(0);
-        // 8 x 8 pixels with one lane, else a tile of 64 / lanes (lane_pixel of gather.wgsl).
-        let pixels = 64 / lanes;
-        let tile_w = 1u32 << pixels.trailing_zeros().div_ceil(2);
-        let tile_h = pixels / tile_w;
-        (
-            self.by_lanes[index].get(imperfect_visibility),
-            [width.div_ceil(tile_w), height.div_ceil(tile_h), 1],
-        )
+        let pipeline = self.by_lanes[index].get(imperfect_visibility);
+        if lanes == COHERENT_LANES {
+            // main_coherent: 8 x 4 interleaving tiles per workgroup, one subset each.
+            let (n, m) = (interleave.0.max(1), interleave.1.max(1));
+            (
+                pipeline,
+                [width.div_ceil(8 * n), height.div_ceil(4 * m), n * m],
+            )
+        } else {
+            // main: 8 x 8 pixels per workgroup.
+            (pipeline, image_groups(width, height))
+        }
     }
 }
 

@@ -112,29 +112,9 @@ fn vpl_irradiance(p: vec3<f32>, ng: vec3<f32>, ns: vec3<f32>, first: u32, count:
     return e;
 }
 
-// Threads that share one pixel's VPL loop in the `main_lanes` entry points (a pipeline
-// constant: 2, 4, 8, ...). A pass with few pixels to gather at (a downsampled image, the
+// Threads that share one pixel's VPL loop in the gathers over a list of pixels (a
+// pipeline constant dividing 256: 1, 8, 32). A pass with few pixels to gather at (the
 // pixels that see a mirror) cannot fill a big GPU with one thread each, so each pixel's
 // VPLs are split over lanes, and lane 0 adds the lanes' sums in lane order (the same
 // image every run).
 override VPL_LANES: u32 = 8u;
-
-var<workgroup> lane_sums: array<vec4<f32>, 64>;
-
-// The pixel of thread `l` of workgroup `group` in `main_lanes`: workgroups of 64 threads
-// cover tiles of 64 / lanes pixels, as square as possible (4 x 2 for 8 lanes).
-fn lane_pixel(group: vec3<u32>, l: u32) -> vec2<u32> {
-    let slot = l / VPL_LANES;
-    let pixels = 64u / VPL_LANES;
-    let tw = 1u << ((firstTrailingBit(pixels) + 1u) / 2u);
-    return vec2<u32>(group.x * tw + slot % tw, group.y * (pixels / tw) + slot / tw);
-}
-
-// Lane 0's total of the lanes' sums of its pixel (after all lanes stored theirs).
-fn lanes_total(l: u32) -> vec3<f32> {
-    var total = vec3<f32>(0.0);
-    for (var i = 0u; i < VPL_LANES; i += 1u) {
-        total += lane_sums[l + i].xyz;
-    }
-    return total;
-}

@@ -43,20 +43,38 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     store_irradiance(gid.x, gid.y, pixel_sum(gid.x, gid.y, 0u, 1u));
 }
 
-// Each pixel's VPLs split over VPL_LANES threads (see gather.wgsl).
-@compute @workgroup_size(64)
-fn main_lanes(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) l: u32) {
-    let p = lane_pixel(group, l);
-    let lane = l % VPL_LANES;
-    let inside = p.x < params.low_width && p.y < params.low_height;
+// Each pixel's VPLs split over 8 threads (lanes), the threads of a warp on 32 pixels of
+// one interleaving subset and one lane: they trace to the same VPL at each step of the
+// loop (rays that end at one point, from neighbouring pixels of the subset; warps that
+// held the 8 lanes of 4 neighbouring pixels traced to 32 different VPLs, which was up
+// to 1.6x slower, docs/PERFORMANCE.md attempt 27). A workgroup is 32 pixels x 8 lanes:
+// the pixels at the same place of 8 x 4 neighbouring interleaving tiles (the same subset
+// with the regular pattern; the irregular one permutes subsets per tile, which costs
+// coherence, not correctness), and group.z is that place in the tile. The lanes' sums
+// are added in lane order: the same image as one lane per pixel, bit for bit.
+var<workgroup> coherent_sums: array<vec4<f32>, 256>;
+
+@compute @workgroup_size(256)
+fn main_coherent(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) l: u32) {
+    let n = params.interleave_n;
+    let m = params.interleave_m;
+    let p = l % 32u;
+    let lane = l / 32u;
+    let x = group.x * 8u * n + (p % 8u) * n + group.z % n;
+    let y = group.y * 4u * m + (p / 8u) * m + group.z / n;
+    let inside = x < params.low_width && y < params.low_height;
     var sum = vec3<f32>(0.0);
     if (inside) {
-        sum = pixel_sum(p.x, p.y, lane, VPL_LANES);
+        sum = pixel_sum(x, y, lane, 8u);
     }
-    lane_sums[l] = vec4<f32>(sum, 0.0);
+    coherent_sums[l] = vec4<f32>(sum, 0.0);
     workgroupBarrier();
     if (inside && lane == 0u) {
-        store_irradiance(p.x, p.y, lanes_total(l));
+        var total = vec3<f32>(0.0);
+        for (var k = 0u; k < 8u; k += 1u) {
+            total += coherent_sums[k * 32u + p].xyz;
+        }
+        store_irradiance(x, y, total);
     }
 }
 
@@ -70,25 +88,34 @@ fn main_lanes(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation
 // Largest workgroup count of one dispatch dimension.
 const MAX_GROUPS: u32 = 65535u;
 
+// Threads of a main_list workgroup, and the listed pixels it takes (each with VPL_LANES
+// lanes).
+const LIST_GROUP: u32 = 256u;
+
 // One thread: takes this frame's count of mirrored pixels, resets the counter for the next
-// frame and sizes main_list's dispatch (VPL_LANES threads per pixel, 64 per workgroup).
+// frame and sizes main_list's dispatch.
 @compute @workgroup_size(1)
 fn mirror_args_main() {
     let n = mirror_list[0];
     mirror_list[0] = 0u;
     mirror_list[1] = n;
-    let groups = (n * VPL_LANES + 63u) / 64u;
+    let per_group = LIST_GROUP / VPL_LANES;
+    let groups = (n + per_group - 1u) / per_group;
     let x = min(groups, MAX_GROUPS);
     mirror_args[0] = x;
     mirror_args[1] = select(0u, (groups + x - 1u) / max(x, 1u), x > 0u);
     mirror_args[2] = 1u;
 }
 
-// main_lanes over the listed pixels: VPL_LANES neighbouring threads per pixel.
-@compute @workgroup_size(64)
+// The gather over the listed pixels, VPL_LANES threads per pixel, a warp holding one
+// lane of 32 pixels (as main_coherent): without interleaving they trace to the same VPL
+// at each step. The lanes' sums are added in lane order.
+@compute @workgroup_size(256)
 fn main_list(@builtin(workgroup_id) group: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>, @builtin(local_invocation_index) l: u32) {
-    let slot = ((group.x + group.y * groups.x) * 64u + l) / VPL_LANES;
-    let lane = l % VPL_LANES;
+    let per_group = LIST_GROUP / VPL_LANES;
+    let p = l % per_group;
+    let lane = l / per_group;
+    let slot = (group.x + group.y * groups.x) * per_group + p;
     let inside = slot < mirror_list[1];
     var pixel = 0u;
     var sum = vec3<f32>(0.0);
@@ -96,9 +123,13 @@ fn main_list(@builtin(workgroup_id) group: vec3<u32>, @builtin(num_workgroups) g
         pixel = mirror_list[2u + slot];
         sum = pixel_sum(pixel % params.low_width, pixel / params.low_width, lane, VPL_LANES);
     }
-    lane_sums[l] = vec4<f32>(sum, 0.0);
+    coherent_sums[l] = vec4<f32>(sum, 0.0);
     workgroupBarrier();
     if (inside && lane == 0u) {
-        store_irradiance(pixel % params.low_width, pixel / params.low_width, lanes_total(l));
+        var total = vec3<f32>(0.0);
+        for (var k = 0u; k < VPL_LANES; k += 1u) {
+            total += coherent_sums[k * per_group + p].xyz;
+        }
+        store_irradiance(pixel % params.low_width, pixel / params.low_width, total);
     }
 }
