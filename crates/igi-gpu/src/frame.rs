@@ -71,8 +71,9 @@ struct ImageBuffers {
     /// the discontinuity buffer over the mirrored hits (interleaved frames).
     mirror_irradiance: wgpu::Buffer,
     mirror_filtered: wgpu::Buffer,
-    /// The pixels with a mirrored hit (direct.wgsl's mirror_list: two counters, then one
-    /// u32 per pixel), and the workgroup counts of the mirror indirect stage's dispatch.
+    /// The pixels with a mirrored hit (direct.wgsl's mirror_list: two counters per
+    /// interleaving subset, then a bucket of pixels per subset), and the workgroup counts
+    /// of the mirror indirect stage's dispatch.
     mirror_list: wgpu::Buffer,
     mirror_args: wgpu::Buffer,
     /// E at the indirect resolution, as the indirect pass leaves it.
@@ -346,7 +347,11 @@ impl Renderer {
         }
         self.images = None;
         let size = width as u64 * height as u64 * 16;
-        let list_size = (2 + width as u64 * height as u64) * 4;
+        // Two counters per subset, then one bucket per subset (direct.wgsl's mirror_list):
+        // n x m buckets of ceil(w / n) ceil(h / m) pixels, at most (w + 63) (h + 63).
+        let list_size = (2 * MAX_SUBSETS as u64
+            + (width as u64 + MAX_SUBSETS as u64 - 1) * (height as u64 + MAX_SUBSETS as u64 - 1))
+            * 4;
         let device = &ctx.device;
         let images = ctx.allocate(
             || format!("the {IMAGE_BUFFERS} frame buffers of a {width}x{height} image"),

@@ -9,7 +9,7 @@ use common::*;
 use glam::Vec3;
 use igi_core::bvh::{offset_ray_origin, Bvh};
 use igi_core::scene::{builtin, Camera, Scene};
-use igi_core::settings::{OutputBuffer, RenderSettings};
+use igi_core::settings::{InterleavePattern, OutputBuffer, RenderSettings};
 use igi_core::vpl::{reflect, surface_at};
 use igi_gpu::Renderer;
 use std::f32::consts::PI;
@@ -255,10 +255,23 @@ fn interleaved_mirrored_hits_stay_close_to_the_full_gather() {
         output: OutputBuffer::Direct,
         ..RenderSettings::for_scene(&scene)
     };
-    let mut il = base.clone();
-    il.accelerations.interleave = (3, 3);
     let full = render(&ctx, &scene, &base);
-    let interleaved = render(&ctx, &scene, &il);
+    for pattern in [InterleavePattern::Regular, InterleavePattern::Irregular] {
+        let mut il = base.clone();
+        il.accelerations.interleave = (3, 3);
+        il.accelerations.pattern = pattern;
+        compare_interleaved(&scene, &base, &full, &render(&ctx, &scene, &il), pattern);
+    }
+}
+
+/// The pixels that see the mirror floor in `full` and `interleaved` (see above).
+fn compare_interleaved(
+    scene: &Scene,
+    base: &RenderSettings,
+    full: &igi_gpu::FrameOutput,
+    interleaved: &igi_gpu::FrameOutput,
+    pattern: InterleavePattern,
+) {
     if !interleaved.stages.is_empty() {
         assert!(interleaved
             .stages
@@ -276,7 +289,7 @@ fn interleaved_mirrored_hits_stay_close_to_the_full_gather() {
             let Some(hit) = bvh.trace_closest(cam.eye, dir, f32::INFINITY) else {
                 continue;
             };
-            let s = surface_at(&scene, &bvh, dir, hit.tri, hit.u, hit.v);
+            let s = surface_at(scene, &bvh, dir, hit.tri, hit.u, hit.v);
             if s.mirror.max_element() <= 0.0 {
                 continue;
             }
@@ -294,7 +307,7 @@ fn interleaved_mirrored_hits_stay_close_to_the_full_gather() {
     }
     let rel = se / s2;
     eprintln!(
-        "{pixels} mirror pixels: mean full {:.4} vs interleaved {:.4}, relative squared error {rel:.5}",
+        "{pattern:?}: {pixels} mirror pixels: mean full {:.4} vs interleaved {:.4}, relative squared error {rel:.5}",
         sum_full / pixels as f64,
         sum_il / pixels as f64
     );
@@ -305,6 +318,13 @@ fn interleaved_mirrored_hits_stay_close_to_the_full_gather() {
     assert!(differ > 1000, "the interleaved gather changed nothing");
     // Measured on lavapipe: 1454 pixels, means 0.1456 vs 0.1443 (0.9%), relative squared
     // error 0.0263 (the reflection is full of small surfaces the filter must not cross).
+    // The irregular pattern: 0.1477 (1.4%), 0.0571: its tiles permute the subsets, so a
+    // filter window not aligned with them can miss some (the same ratio as on the whole
+    // conference room, 0.0407 against 0.0389).
     assert!((sum_full - sum_il).abs() < 0.02 * sum_full);
-    assert!(rel < 0.035, "relative squared error {rel}");
+    let bound = match pattern {
+        InterleavePattern::Regular => 0.035,
+        InterleavePattern::Irregular => 0.07,
+    };
+    assert!(rel < bound, "{pattern:?}: relative squared error {rel}");
 }

@@ -28,10 +28,11 @@
 @group(1) @binding(9) var<storage, read_write> mirror_normal: array<vec4<f32>>;
 @group(1) @binding(10) var<storage, read_write> mirror_geometric: array<vec4<f32>>;
 @group(1) @binding(11) var<storage, read_write> mirror_weight: array<vec4<f32>>;
-// The pixels that have such a hit, in no particular order, for the mirror indirect stage
-// to gather at only them: [0] counts the appended pixels (reset by indirect.wgsl's
-// mirror_args once it has read it), [1] is that stage's copy of the count, the pixels
-// follow from [2] on.
+// The pixels that have such a hit, for the mirror indirect stage to gather at only them,
+// in one bucket per interleaving subset (see mirror_bucket in gather.wgsl): [s] counts
+// the pixels appended to bucket s (reset by indirect.wgsl's mirror_args_main once it has
+// read them), [MAX_SUBSETS + s] is that stage's copy of the count, bucket s starts at
+// 2 MAX_SUBSETS + s mirror_bucket_size().
 @group(1) @binding(12) var<storage, read_write> mirror_list: array<atomic<u32>>;
 
 @compute @workgroup_size(8, 8)
@@ -90,7 +91,9 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             if (depth > 0u && !recorded) {
                 recorded = true;
                 if (first_walk) {
-                    atomicStore(&mirror_list[2u + atomicAdd(&mirror_list[0], 1u)], pixel);
+                    let bucket = interleave_subset(gid.x, gid.y);
+                    let slot = atomicAdd(&mirror_list[bucket], 1u);
+                    atomicStore(&mirror_list[2u * MAX_SUBSETS + bucket * mirror_bucket_size() + slot], pixel);
                     mirror_position[pixel] = vec4<f32>(s.position, 1.0);
                     mirror_normal[pixel] = vec4<f32>(s.shading_normal, travelled);
                     mirror_geometric[pixel] = vec4<f32>(s.geometric_normal, 0.0);

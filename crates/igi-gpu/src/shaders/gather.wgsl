@@ -60,6 +60,18 @@ fn interleave_subset(x: u32, y: u32) -> u32 {
     return perm[local];
 }
 
+// Most interleaving subsets (frame.rs MAX_SUBSETS).
+const MAX_SUBSETS: u32 = 64u;
+
+// Room for the pixels of one interleaving subset in the list of mirrored pixels
+// (direct.wgsl's mirror_list): every n x m tile of the full-resolution image, partial
+// ones at the edges included, holds one pixel of each subset.
+fn mirror_bucket_size() -> u32 {
+    let n = params.interleave_n;
+    let m = params.interleave_m;
+    return ((params.width + n - 1u) / n) * ((params.height + m - 1u) / m);
+}
+
 // E at surface point p from the interleaving subset of pixel (x, y) of the image being
 // gathered: the subset's VPLs within this dispatch's range, from `lane` on, every
 // `lanes`-th (not yet scaled by the number of subsets).

@@ -50,7 +50,8 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
 // to 1.6x slower, docs/PERFORMANCE.md attempt 27). A workgroup is 32 pixels x 8 lanes:
 // the pixels at the same place of 8 x 4 neighbouring interleaving tiles (the same subset
 // with the regular pattern; the irregular one permutes subsets per tile, which costs
-// coherence, not correctness), and group.z is that place in the tile. The lanes' sums
+// coherence, not correctness: attempt 30), and group.z is that place in the tile. The
+// lanes' sums
 // are added in lane order: the same image as one lane per pixel, bit for bit.
 var<workgroup> coherent_sums: array<vec4<f32>, 256>;
 
@@ -80,7 +81,9 @@ fn main_coherent(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocat
 
 // The mirror indirect stage over the list of mirrored pixels (direct.wgsl's mirror_list):
 // about one pixel in twenty sees a mirror in the conference room, and a dispatch over the
-// whole image spent most of its workgroups on pixels with nothing to gather.
+// whole image spent most of its workgroups on pixels with nothing to gather. The list
+// has one bucket per interleaving subset, so that the 32 pixels of a warp gather the
+// same VPLs in step, as in main_coherent.
 @group(3) @binding(0) var<storage, read_write> mirror_list: array<u32>;
 // Workgroups of main_list (x, y, z), for dispatch_workgroups_indirect.
 @group(3) @binding(1) var<storage, read_write> mirror_args: array<u32>;
@@ -92,35 +95,42 @@ const MAX_GROUPS: u32 = 65535u;
 // lanes).
 const LIST_GROUP: u32 = 256u;
 
-// One thread: takes this frame's count of mirrored pixels, resets the counter for the next
-// frame and sizes main_list's dispatch.
+// One thread: takes this frame's counts of mirrored pixels, resets the counters for the
+// next frame and sizes main_list's dispatch: one z layer per subset, as many workgroups
+// as the fullest bucket needs.
 @compute @workgroup_size(1)
 fn mirror_args_main() {
-    let n = mirror_list[0];
-    mirror_list[0] = 0u;
-    mirror_list[1] = n;
+    let subsets = params.interleave_n * params.interleave_m;
+    var most = 0u;
+    for (var s = 0u; s < subsets; s += 1u) {
+        let n = mirror_list[s];
+        mirror_list[s] = 0u;
+        mirror_list[MAX_SUBSETS + s] = n;
+        most = max(most, n);
+    }
     let per_group = LIST_GROUP / VPL_LANES;
-    let groups = (n + per_group - 1u) / per_group;
+    let groups = (most + per_group - 1u) / per_group;
     let x = min(groups, MAX_GROUPS);
     mirror_args[0] = x;
     mirror_args[1] = select(0u, (groups + x - 1u) / max(x, 1u), x > 0u);
-    mirror_args[2] = 1u;
+    mirror_args[2] = select(0u, subsets, x > 0u);
 }
 
-// The gather over the listed pixels, VPL_LANES threads per pixel, a warp holding one
-// lane of 32 pixels (as main_coherent): without interleaving they trace to the same VPL
-// at each step. The lanes' sums are added in lane order.
+// The gather over the listed pixels of bucket group.z, VPL_LANES threads per pixel, a
+// warp holding one lane of 32 pixels (as main_coherent): they trace to the same VPL at
+// each step. The lanes' sums are added in lane order.
 @compute @workgroup_size(256)
 fn main_list(@builtin(workgroup_id) group: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>, @builtin(local_invocation_index) l: u32) {
     let per_group = LIST_GROUP / VPL_LANES;
     let p = l % per_group;
     let lane = l / per_group;
+    let bucket = group.z;
     let slot = (group.x + group.y * groups.x) * per_group + p;
-    let inside = slot < mirror_list[1];
+    let inside = slot < mirror_list[MAX_SUBSETS + bucket];
     var pixel = 0u;
     var sum = vec3<f32>(0.0);
     if (inside) {
-        pixel = mirror_list[2u + slot];
+        pixel = mirror_list[2u * MAX_SUBSETS + bucket * mirror_bucket_size() + slot];
         sum = pixel_sum(pixel % params.low_width, pixel / params.low_width, lane, VPL_LANES);
     }
     coherent_sums[l] = vec4<f32>(sum, 0.0);
