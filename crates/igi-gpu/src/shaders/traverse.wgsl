@@ -268,6 +268,10 @@ fn trace_closest(origin: vec3<f32>, dir: vec3<f32>, tmax: f32) -> Hit {
 }
 
 // Whether some triangle is hit with 0 < t < tmax (occlusion); returns at the first.
+// Children are visited in fixed order (a, then b): nearer-first ordering, which closest
+// hits need, made frames 4-7% slower here (docs/PERFORMANCE.md attempt 31; probably
+// because a fixed order keeps the walks of a warp's rays, which end at one point, in
+// step).
 // With `boxes` (imperfect visibility), a triangle whose box the segment crosses counts
 // as a hit (see box_crossed).
 fn trace_shadow(origin: vec3<f32>, dir: vec3<f32>, tmax: f32, boxes: bool) -> bool {
@@ -282,32 +286,25 @@ fn trace_shadow(origin: vec3<f32>, dir: vec3<f32>, tmax: f32, boxes: bool) -> bo
         let n = bvh_nodes[node];
         let ta = box_near(n.a_min, n.a_max, r, tmax);
         let tb = box_near(n.b_min, n.b_max, r, tmax);
-        let b_first = tb >= 0.0 && (ta < 0.0 || tb < ta);
-        let t0 = select(ta, tb, b_first);
-        let i0 = select(n.a_index, n.b_index, b_first);
-        let c0 = select(n.a_count, n.b_count, b_first);
-        let t1 = select(tb, ta, b_first);
-        let i1 = select(n.b_index, n.a_index, b_first);
-        let c1 = select(n.b_count, n.a_count, b_first);
         var next = NO_HIT;
-        if (t0 >= 0.0) {
-            if (c0 > 0u) {
-                if (leaf_any(i0, c0, r, tmax, boxes)) {
+        if (ta >= 0.0) {
+            if (n.a_count > 0u) {
+                if (leaf_any(n.a_index, n.a_count, r, tmax, boxes)) {
                     return true;
                 }
             } else {
-                next = i0;
+                next = n.a_index;
             }
         }
-        if (t1 >= 0.0) {
-            if (c1 > 0u) {
-                if (leaf_any(i1, c1, r, tmax, boxes)) {
+        if (tb >= 0.0) {
+            if (n.b_count > 0u) {
+                if (leaf_any(n.b_index, n.b_count, r, tmax, boxes)) {
                     return true;
                 }
             } else if (next == NO_HIT) {
-                next = i1;
+                next = n.b_index;
             } else {
-                stack[sp] = i1;
+                stack[sp] = n.b_index;
                 sp += 1u;
             }
         }
