@@ -14,7 +14,7 @@ use crate::passes::filter::{Filter, FilterPass};
 use crate::passes::indirect::IndirectPass;
 use crate::passes::vpl::VplPass;
 use crate::passes::{
-    dispatch, gather_range_layout, lanes_for, mirror_lanes, Dispatches, GatherRanges, Recorder,
+    gather_range_layout, lanes_for, mirror_lanes, Dispatches, GatherRanges, Recorder,
     GATHER_RANGE_STRIDE,
 };
 use crate::profiler::{Profiler, StageTime};
@@ -577,9 +577,8 @@ impl Renderer {
             &self.halton_perms.1,
         );
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        dispatch(
-            &mut encoder,
-            &Profiler::disabled(),
+        let untimed = Profiler::disabled();
+        Recorder::new(&mut encoder, &untimed, "vpl pilot").dispatch(
             0,
             "vpl pilot",
             &self.vpl.steps(PILOT_PATHS),

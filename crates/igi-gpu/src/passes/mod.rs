@@ -330,35 +330,6 @@ pub(crate) struct Dispatches<'a> {
     pub indirect: Option<&'a wgpu::Buffer>,
 }
 
-/// One compute pass with its own timestamp pair, running each step's pipeline over its
-/// workgroups; with `ranges`, every step runs once per VPL range (bind group 2).
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn dispatch(
-    encoder: &mut wgpu::CommandEncoder,
-    profiler: &Profiler,
-    stage: u32,
-    label: &str,
-    steps: &[(&wgpu::ComputePipeline, [u32; 3])],
-    scene: &wgpu::BindGroup,
-    pass: &wgpu::BindGroup,
-    ranges: Option<&GatherRanges>,
-) {
-    dispatch_together(
-        encoder,
-        profiler,
-        stage,
-        label,
-        &[Dispatches {
-            steps,
-            scene,
-            pass,
-            ranges,
-            group3: None,
-            indirect: None,
-        }],
-    );
-}
-
 /// The dispatches of several passes in one compute pass (one timestamp pair), run side by
 /// side: wgpu records each compute pass into a command buffer of its own, and the GPU
 /// does not run work of two command buffers at once (measured on the H200,
