@@ -8,26 +8,11 @@ mod common;
 use common::*;
 use glam::Vec3;
 use igi_core::bvh::{offset_ray_origin, Bvh};
-use igi_core::scene::{builtin, Camera, Scene};
+use igi_core::scene::{Camera, Scene};
 use igi_core::settings::{InterleavePattern, OutputBuffer, RenderSettings};
 use igi_core::vpl::{reflect, surface_at};
 use igi_gpu::Renderer;
 use std::f32::consts::PI;
-
-/// The built-in Cornell box with its floor made of `diffuse` + `mirror`.
-fn mirror_floor(diffuse: Vec3, mirror: Vec3) -> Scene {
-    let mut scene = builtin::builtin_scene("cornell-box").unwrap();
-    scene
-        .materials
-        .push(material("floor mirror", diffuse, mirror));
-    let floor_material = scene.materials.len() as u32 - 1;
-    for t in &mut scene.triangles {
-        if t.v.iter().all(|v| v.y.abs() < 1e-4) {
-            t.material = floor_material;
-        }
-    }
-    scene
-}
 
 /// The primary ray direction of pixel (x, y), as frame.wgsl makes it (frame 0).
 fn primary_dir(cam: &Camera, width: u32, height: u32, x: u32, y: u32) -> Vec3 {

@@ -40,6 +40,21 @@ pub fn render(ctx: &GpuContext, scene: &Scene, settings: &RenderSettings) -> Fra
     renderer.render(ctx, settings).expect("frame")
 }
 
+/// The built-in Cornell box with its floor made of `diffuse` + `mirror`.
+pub fn mirror_floor(diffuse: Vec3, mirror: Vec3) -> Scene {
+    let mut scene = igi_core::scene::builtin::builtin_scene("cornell-box").unwrap();
+    scene
+        .materials
+        .push(material("floor mirror", diffuse, mirror));
+    let floor_material = scene.materials.len() as u32 - 1;
+    for t in &mut scene.triangles {
+        if t.v.iter().all(|v| v.y.abs() < 1e-4) {
+            t.material = floor_material;
+        }
+    }
+    scene
+}
+
 pub fn material(name: &str, diffuse: Vec3, mirror: Vec3) -> Material {
     Material {
         name: name.into(),
