@@ -1,8 +1,13 @@
 //! Direct + specular at full resolution (paper section 4, second stage), writing the
 //! G-buffer of the primary hits. See `shaders/direct.wgsl`.
 
-use super::{bind, image_groups, pass_layout, GatherPipelines};
+use super::{bind, pass_layout, GatherPipelines};
 use crate::scene_buffers::{READ, UNIFORM, WRITE};
+
+/// Pixels per workgroup of the direct pass (`@workgroup_size` of direct.wgsl): one warp,
+/// 8 x 4, measured faster than 8 x 8, 16 x 8, 16 x 16, 16 x 2 and 32 x 1 on the H200
+/// (docs/PERFORMANCE.md, attempt 32).
+pub const DIRECT_TILE: (u32, u32) = (8, 4);
 
 pub struct DirectPass {
     pub layout: wgpu::BindGroupLayout,
@@ -86,7 +91,11 @@ impl DirectPass {
     ) -> [(&wgpu::ComputePipeline, [u32; 3]); 1] {
         [(
             self.pipelines.get(imperfect_visibility),
-            image_groups(width, height),
+            [
+                width.div_ceil(DIRECT_TILE.0),
+                height.div_ceil(DIRECT_TILE.1),
+                1,
+            ],
         )]
     }
 }

@@ -35,7 +35,9 @@
 // 2 MAX_SUBSETS + s mirror_bucket_size().
 @group(1) @binding(12) var<storage, read_write> mirror_list: array<atomic<u32>>;
 
-@compute @workgroup_size(8, 8)
+// One thread per pixel, 8 x 4 pixels (one warp) per workgroup: 8 x 8 took 0.74 ms against
+// 0.66 ms on the H200 (conference room, 800 x 600; docs/PERFORMANCE.md attempt 32).
+@compute @workgroup_size(8, 4)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (gid.x >= params.width || gid.y >= params.height) {
         return;
