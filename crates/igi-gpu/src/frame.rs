@@ -965,7 +965,7 @@ impl Renderer {
         // other: both fill the GPU. docs/PERFORMANCE.md, attempt 22.)
         let mut mirror_e = &img.mirror_irradiance;
         if self.has_mirrors {
-            let (list_pipeline, _) = self.indirect.list_pipeline(iv);
+            let list_pipeline = self.indirect.list_pipeline(iv);
             let i = stage("mirror indirect");
             rec.stage(
                 i,

@@ -17,9 +17,8 @@ pub struct IndirectPass {
     /// arguments may not be bound for storage in the same dispatch).
     list_layout: wgpu::BindGroupLayout,
     args_layout: wgpu::BindGroupLayout,
-    /// The gather over the listed pixels (`main_list`), `list_lanes` lanes per pixel.
+    /// The gather over the listed pixels (`main_list`).
     list: GatherPipelines,
-    list_lanes: u32,
     /// Reads the list's length and writes the indirect dispatch (`mirror_args_main`).
     args: wgpu::ComputePipeline,
 }
@@ -51,7 +50,6 @@ impl IndirectPass {
                 &[scene_layout, &layout, range_layout],
             ),
             list: GatherPipelines::new(device, "indirect", "main_list", &layouts, &lanes),
-            list_lanes,
             args: pipeline_with_constants(
                 device,
                 "indirect",
@@ -89,9 +87,9 @@ impl IndirectPass {
         (&self.args, [1, 1, 1])
     }
 
-    /// The gather over the listed pixels (dispatched indirectly), and its lanes per pixel.
-    pub fn list_pipeline(&self, imperfect_visibility: bool) -> (&wgpu::ComputePipeline, u32) {
-        (self.list.get(imperfect_visibility), self.list_lanes)
+    /// The gather over the listed pixels (dispatched indirectly, see [`Self::args_step`]).
+    pub fn list_pipeline(&self, imperfect_visibility: bool) -> &wgpu::ComputePipeline {
+        self.list.get(imperfect_visibility)
     }
 
     pub fn bind(&self, device: &wgpu::Device, buffers: &[&wgpu::Buffer; 7]) -> wgpu::BindGroup {
