@@ -165,18 +165,14 @@ impl Renderer {
     /// Upload the scene and its BVH, and build the passes.
     pub fn new(ctx: &GpuContext, scene: &Scene, bvh: &Bvh) -> Result<Renderer, GpuError> {
         let device = &ctx.device;
+        let software = ctx.info.device_type == wgpu::DeviceType::Cpu;
         let scene_buffers = SceneBuffers::upload(ctx, scene, bvh)?;
         let layout = &scene_buffers.layout;
         let range_layout = gather_range_layout(device);
         let renderer = Renderer {
             vpl: VplPass::new(device, layout),
             direct: DirectPass::new(device, layout, &range_layout),
-            indirect: IndirectPass::new(
-                device,
-                layout,
-                &range_layout,
-                mirror_lanes(ctx.info.device_type == wgpu::DeviceType::Cpu),
-            ),
+            indirect: IndirectPass::new(device, layout, &range_layout, mirror_lanes(software)),
             range_layout,
             range_buffer: None,
             vpls_per_dispatch: ctx.vpls_per_dispatch(),
@@ -210,7 +206,7 @@ impl Renderer {
             diagonal: scene.diagonal(),
             path_cache: None,
             counting: false,
-            software: ctx.info.device_type == wgpu::DeviceType::Cpu,
+            software,
             has_mirrors: scene.materials.iter().any(|m| m.mirror.max_element() > 0.0),
         };
         ctx.check()?;
@@ -901,22 +897,26 @@ impl Renderer {
         );
 
         // The indirect pass over the mirror record (the mirror indirect stage below),
-        // gathering only at the pixels the direct pass listed.
-        let mirror_bind = self.indirect.bind(
-            device,
-            &[
-                &self.mirror_params,
-                &vb.vpls,
-                &self.vpl_header,
-                &img.mirror[0],
-                &img.mirror[1],
-                &img.mirror[2],
-                &img.mirror_irradiance,
-            ],
-        );
-        let (list_bind, args_bind) =
-            self.indirect
+        // gathering only at the pixels the direct pass listed; its bind groups and those
+        // of the list, in scenes with mirrors.
+        let mirror_groups = self.has_mirrors.then(|| {
+            let bind = self.indirect.bind(
+                device,
+                &[
+                    &self.mirror_params,
+                    &vb.vpls,
+                    &self.vpl_header,
+                    &img.mirror[0],
+                    &img.mirror[1],
+                    &img.mirror[2],
+                    &img.mirror_irradiance,
+                ],
+            );
+            let (list, args) = self
+                .indirect
                 .bind_list(device, &img.mirror_list, &img.mirror_args);
+            (bind, list, args)
+        });
         let one_range = GatherRanges {
             bind_group: range_group,
             first: 1,
@@ -932,14 +932,14 @@ impl Renderer {
             group3: None,
             indirect: None,
         }];
-        if self.has_mirrors {
+        if let Some((mirror_bind, _, args_bind)) = &mirror_groups {
             // Sizes the mirror indirect dispatch from the list's length.
             list_parts.push(Dispatches {
                 steps: &args_step,
                 scene,
-                pass: &mirror_bind,
+                pass: mirror_bind,
                 ranges: Some(&one_range),
-                group3: Some(&args_bind),
+                group3: Some(args_bind),
                 indirect: None,
             });
         }
@@ -964,7 +964,7 @@ impl Renderer {
         // the indirect stage, in one compute pass, the two took as long as one after the
         // other: both fill the GPU. docs/PERFORMANCE.md, attempt 22.)
         let mut mirror_e = &img.mirror_irradiance;
-        if self.has_mirrors {
+        if let Some((mirror_bind, list_bind, _)) = &mirror_groups {
             let list_pipeline = self.indirect.list_pipeline(iv);
             let i = stage("mirror indirect");
             rec.stage(
@@ -973,9 +973,9 @@ impl Renderer {
                 &[Dispatches {
                     steps: &[(list_pipeline, [0, 0, 0])],
                     scene,
-                    pass: &mirror_bind,
+                    pass: mirror_bind,
                     ranges: Some(&ranges),
-                    group3: Some(&list_bind),
+                    group3: Some(list_bind),
                     indirect: Some(&img.mirror_args),
                 }],
             );

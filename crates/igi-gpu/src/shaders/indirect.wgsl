@@ -55,6 +55,16 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
 // are added in lane order: the same image as one lane per pixel, bit for bit.
 var<workgroup> coherent_sums: array<vec4<f32>, 256>;
 
+// The sum of pixel p's `lanes` lane sums in lane order (lane k of the workgroup's
+// `pixels` pixels stored its sum at k pixels + p), after a workgroup barrier.
+fn lanes_total(p: u32, pixels: u32, lanes: u32) -> vec3<f32> {
+    var total = vec3<f32>(0.0);
+    for (var k = 0u; k < lanes; k += 1u) {
+        total += coherent_sums[k * pixels + p].xyz;
+    }
+    return total;
+}
+
 @compute @workgroup_size(256)
 fn main_coherent(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) l: u32) {
     let n = params.interleave_n;
@@ -71,11 +81,7 @@ fn main_coherent(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocat
     coherent_sums[l] = vec4<f32>(sum, 0.0);
     workgroupBarrier();
     if (inside && lane == 0u) {
-        var total = vec3<f32>(0.0);
-        for (var k = 0u; k < 8u; k += 1u) {
-            total += coherent_sums[k * 32u + p].xyz;
-        }
-        store_irradiance(x, y, total);
+        store_irradiance(x, y, lanes_total(p, 32u, 8u));
     }
 }
 
@@ -136,10 +142,6 @@ fn main_list(@builtin(workgroup_id) group: vec3<u32>, @builtin(num_workgroups) g
     coherent_sums[l] = vec4<f32>(sum, 0.0);
     workgroupBarrier();
     if (inside && lane == 0u) {
-        var total = vec3<f32>(0.0);
-        for (var k = 0u; k < VPL_LANES; k += 1u) {
-            total += coherent_sums[k * per_group + p].xyz;
-        }
-        store_irradiance(pixel % params.low_width, pixel / params.low_width, total);
+        store_irradiance(pixel % params.low_width, pixel / params.low_width, lanes_total(p, per_group, VPL_LANES));
     }
 }
