@@ -222,6 +222,33 @@ pub(crate) fn pass_layout(
     })
 }
 
+/// What wgpu checks at run time in the pass shaders: everything it checks by default
+/// except index bounds and loop bounding, which cost every BVH walk 7-9% on the H200
+/// (frame rays 3.50 -> 3.81 G rays/s, iv+ds+il 1.27 -> 1.19 ms at 800 x 600;
+/// docs/PERFORMANCE.md attempt 34). `IGI_SHADER_CHECKS=1` restores wgpu's defaults, to
+/// look for a bug or to measure.
+///
+/// What the pass shaders promise instead:
+/// * Every loop ends. Loops count up to a frame parameter or a count of a buffer, in steps
+///   of at least 1 (lanes and strides are 1 or more); the Halton digit loop ends within 32
+///   steps (its reach grows by the base, at least 2); the BVH walks visit each node at
+///   most once, because the nodes form a tree (built by `igi_core::bvh`, whose tests walk
+///   it). With wgpu's loop bound a loop that did not end would end early with a wrong
+///   result; without it, it hangs the GPU. Both are bugs, which the tests would show.
+/// * Every index into a function or workgroup array is in bounds: the traversal stack
+///   holds at most `STACK_SIZE` entries (proved at `igi_core::bvh::STACK_SIZE`, checked
+///   by a test), the irregular pattern's permutation has n x m <= 64 entries (the frame
+///   refuses larger interleaving), the Halton tables are indexed modulo 64, and the
+///   workgroup sums by invocation indices below the workgroup size. Storage buffers stay
+///   bounds-checked by the device itself on Vulkan (robust buffer access, which wgpu
+///   enables where the device has it).
+pub const TRUSTED_CHECKS: wgpu::ShaderRuntimeChecks = {
+    let mut checks = wgpu::ShaderRuntimeChecks::checked();
+    checks.bounds_checks = false;
+    checks.force_loop_bounding = false;
+    checks
+};
+
 /// A compute pipeline for `entry` of the named pass; `layouts` are its bind groups in
 /// order (the scene first).
 pub(crate) fn pipeline(
@@ -246,7 +273,13 @@ pub(crate) fn pipeline_with_constants(
         label: Some(name),
         source: wgpu::ShaderSource::Wgsl(crate::shader::compose(source).into()),
     };
-    let module = device.create_shader_module(desc);
+    let module = if std::env::var_os("IGI_SHADER_CHECKS").is_some_and(|v| v == "1") {
+        device.create_shader_module(desc)
+    } else {
+        // SAFETY: the pass shaders keep the two promises that wgpu's own checks would
+        // otherwise enforce (see `TRUSTED_CHECKS`).
+        unsafe { device.create_shader_module_trusted(desc, TRUSTED_CHECKS) }
+    };
     let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some(name),
         bind_group_layouts: &layouts.iter().map(|l| Some(*l)).collect::<Vec<_>>(),
