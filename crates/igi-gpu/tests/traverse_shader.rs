@@ -83,6 +83,8 @@ fn constants_match_the_cpu_twin() {
     assert_eq!(f("BOX_TFAR_SCALE"), 1.0 + 3.0 * f32::EPSILON);
     assert_eq!(f("DIR_EPS"), 1e-30);
     assert_eq!(f("PARALLEL_INV"), 1e30);
+    assert_eq!(f("PARALLEL_SLACK"), 1.0 / 1_048_576.0);
+    // Used by the GPU's box_crossed only (imperfect visibility has no CPU twin).
     assert_eq!(f("FAR_BIG"), 1e38);
     assert_eq!(f("OFFSET_ORIGIN"), 1.0 / 32.0);
     assert_eq!(f("OFFSET_FLOAT_SCALE"), 1.0 / 65536.0);

@@ -17,12 +17,21 @@ pub const NO_HIT: u32 = 0xffff_ffff;
 /// WGSL leaves the result of operations on infinities and NaNs indeterminate, so the IEEE
 /// trick of an infinite reciprocal (and the 0 * inf = NaN it gives for an origin on a
 /// slab plane, which pbrt's comparison order ignores) cannot be relied on in the shader.
-/// A parallel axis gets the finite reciprocal [`PARALLEL_INV`] instead: its entry
-/// distance (min - o) * 1e30 is <= 0 inside the slab and, outside it, a distance beyond
-/// any real one unless the origin is within ~1e-23 of the plane (then the box is merely
-/// visited for nothing: conservative). Its exit distance (max - o) * 1e30 would be 0 for
-/// an origin on the max plane, where the ray runs inside the closed slab: any exit
-/// distance >= 0 of a parallel axis is therefore replaced by [`FAR_BIG`]. No NaN or
+/// A parallel axis gets the finite reciprocal [`PARALLEL_INV`] instead. Its slab
+/// distances (min - o) * 1e30 and (max - o) * 1e30 are right for an origin clearly inside
+/// or outside the slab, but an origin on a plane (the ray runs inside the closed slab, as
+/// rays along a wall do) gives an exit distance of 0: the box would be missed. So the
+/// planes of a parallel axis are measured from an origin moved by the slack
+/// s = (|o| + 1) [`PARALLEL_SLACK`] (a relative 2^-20, far above the rounding of o + s):
+/// entry planes from o + s, exit planes from o - s ([`TraceRay::origin_lo`] and
+/// `origin_hi`). The ray then tests the slab [min - s, max + s]: inside it the entry
+/// distance is <= -s 1e30 and the exit distance >= s 1e30 >= 9.5e23, beyond every box a
+/// ray can reach unless its direction is shorter than 1e-24 x the scene's extent and its
+/// length unbounded; outside it the box is missed, or visited for nothing when the origin
+/// lies within 1e-23 of the widened slab (conservative). This costs the slab test
+/// nothing per box; the select that replaced exit distances >= 0 of parallel axes by a
+/// large value did, 6-10% of every walk (docs/PERFORMANCE.md attempt 35). Boxes only get
+/// wider along parallel axes, so the answers stay those of the exact test. No NaN or
 /// infinity arises from finite data (coordinates up to ~1e7); the only infinities are
 /// those of the empty child's box (+inf, -inf), whose distances are +-inf and only make
 /// it miss.
@@ -32,9 +41,8 @@ pub const NO_HIT: u32 = 0xffff_ffff;
 pub(crate) const DIR_EPS: f32 = 1e-30;
 /// Reciprocal used for parallel axes (see [`DIR_EPS`]).
 pub(crate) const PARALLEL_INV: f32 = 1e30;
-/// "Never leaves the slab": the exit distance of a parallel axis the ray lies inside.
-/// Finite, and small enough that BOX_TFAR_SCALE * FAR_BIG stays finite.
-pub(crate) const FAR_BIG: f32 = 1e38;
+/// Relative widening of the slab of a parallel axis (see [`DIR_EPS`]): 2^-20.
+pub(crate) const PARALLEL_SLACK: f32 = 1.0 / 1_048_576.0;
 
 /// Conservative rounding factor for the far end of a slab: 1 + 2 gamma(3) with
 /// gamma(n) = n eps / (1 - n eps), eps = 2^-24 (pbrt-v3/v4 `Bounds3::IntersectP`, Ize
@@ -75,8 +83,6 @@ pub(crate) struct TraceRay {
     inv_dir: Vec3,
     /// Per axis: whether inv_dir < 0 (then the slab is entered at the box maximum).
     neg: [bool; 3],
-    /// Per axis: |dir| < DIR_EPS, the ray is parallel to the slab.
-    parallel: [bool; 3],
     /// Woop et al.: kz is the axis of the largest |dir| component, (kx, ky) the other two
     /// in an order that keeps the triangles' winding.
     kx: usize,
@@ -84,6 +90,11 @@ pub(crate) struct TraceRay {
     kz: usize,
     /// Shear constants (Sx, Sy, Sz) = (dir[kx] / dir[kz], dir[ky] / dir[kz], 1 / dir[kz]).
     shear: Vec3,
+    /// The origin the slab test measures entry planes from: `origin`, moved by
+    /// [`PARALLEL_SLACK`] (|o| + 1) along the parallel axes (see [`DIR_EPS`]).
+    origin_lo: Vec3,
+    /// The same for exit planes, moved the other way.
+    origin_hi: Vec3,
 }
 
 impl TraceRay {
@@ -116,11 +127,19 @@ impl TraceRay {
             std::mem::swap(&mut kx, &mut ky);
         }
         let shear = Vec3::new(dir[kx] / dir[kz], dir[ky] / dir[kz], 1.0 / dir[kz]);
+        let slack = Vec3::from_array([0, 1, 2].map(|k| {
+            if parallel[k] {
+                (origin[k].abs() + 1.0) * PARALLEL_SLACK
+            } else {
+                0.0
+            }
+        }));
         Some(TraceRay {
+            origin_lo: origin + slack,
+            origin_hi: origin - slack,
             origin,
             inv_dir,
             neg: [inv_dir.x < 0.0, inv_dir.y < 0.0, inv_dir.z < 0.0],
-            parallel,
             kx,
             ky,
             kz,
@@ -132,24 +151,18 @@ impl TraceRay {
 /// Slab test. Returns the entry distance (>= 0) when the box is hit within [0, tmax],
 /// -1 otherwise. The entry plane of each axis is chosen by the sign of the direction
 /// (not by min/max of both planes), so an inverted empty box (min = +inf, max = -inf)
-/// enters at +inf and leaves at -inf: never hit.
+/// enters at +inf and leaves at -inf: never hit. Parallel axes need no case of their
+/// own: their planes are measured from the moved origins (see [`DIR_EPS`]).
 #[inline]
 fn box_near(min: [f32; 3], max: [f32; 3], r: &TraceRay, tmax: f32) -> f32 {
-    let t0 = (Vec3::from(min) - r.origin) * r.inv_dir;
-    let t1 = (Vec3::from(max) - r.origin) * r.inv_dir;
+    let t0 = (Vec3::from(min) - r.origin_lo) * r.inv_dir;
+    let t1 = (Vec3::from(max) - r.origin_hi) * r.inv_dir;
     let pick = |k: usize| {
-        let (near, far) = if r.neg[k] {
+        if r.neg[k] {
             (t1[k], t0[k])
         } else {
             (t0[k], t1[k])
-        };
-        // A parallel axis the origin lies inside (or on a plane of) never exits.
-        let far = if r.parallel[k] && far >= 0.0 {
-            FAR_BIG
-        } else {
-            far
-        };
-        (near, far)
+        }
     };
     let (nx, fx) = pick(0);
     let (ny, fy) = pick(1);

@@ -26,7 +26,11 @@ const STACK_SIZE: u32 = 60u;
 const DIR_EPS: f32 = 1e-30;
 // Reciprocal of a parallel axis: finite, since WGSL makes inf and NaN indeterminate.
 const PARALLEL_INV: f32 = 1e30;
-// Exit distance of a parallel axis whose slab contains the origin: "never exits".
+// The slab of an axis the ray is parallel to is widened by (|o| + 1) x PARALLEL_SLACK
+// (2^-20) on both sides, so that an origin on its plane is inside (igi_core's DIR_EPS
+// says why and what it costs).
+const PARALLEL_SLACK: f32 = 0.00000095367431640625;
+// A distance beyond every real one (box_crossed's parallel axes).
 const FAR_BIG: f32 = 1e38;
 // 1 + 2 gamma(3), rounded to f32 (1 + 3 ulp): conservative far end of a slab.
 const BOX_TFAR_SCALE: f32 = 1.0000003576278687;
@@ -57,8 +61,12 @@ struct TraceRay {
     kz: u32,
     // inv_dir < 0: the slab of that axis is entered at the box maximum.
     neg: vec3<bool>,
-    // |dir| < DIR_EPS: the ray is parallel to that axis' slab.
+    // |dir| < DIR_EPS: the ray is parallel to that axis' slab (box_crossed).
     parallel: vec3<bool>,
+    // The origins box_near measures entry (origin_lo) and exit (origin_hi) planes from:
+    // `origin`, moved by the slack of PARALLEL_SLACK along parallel axes.
+    origin_lo: vec3<f32>,
+    origin_hi: vec3<f32>,
 }
 
 // The shadow ray of a segment between two surface points (see shadow_segment).
@@ -88,18 +96,19 @@ fn make_ray(origin: vec3<f32>, dir: vec3<f32>) -> TraceRay {
         ky = k;
     }
     let shear = vec3<f32>(dir[kx] / dir[kz], dir[ky] / dir[kz], 1.0 / dir[kz]);
-    return TraceRay(origin, inv_dir, shear, kx, ky, kz, inv_dir < vec3<f32>(0.0), parallel);
+    let slack = select(vec3<f32>(0.0), (abs(origin) + 1.0) * PARALLEL_SLACK, parallel);
+    return TraceRay(origin, inv_dir, shear, kx, ky, kz, inv_dir < vec3<f32>(0.0), parallel, origin + slack, origin - slack);
 }
 
 // Slab test: the entry distance (>= 0) of a box hit within [0, tmax], or -1. Entry planes
 // are chosen by the direction's sign, so an inverted empty box (+inf, -inf) is never hit.
+// Parallel axes need no case of their own: their planes are measured from the moved
+// origins (the select this replaced cost 6-10% of every walk, PERFORMANCE.md attempt 35).
 fn box_near(bmin: vec3<f32>, bmax: vec3<f32>, r: TraceRay, tmax: f32) -> f32 {
-    let t0 = (bmin - r.origin) * r.inv_dir;
-    let t1 = (bmax - r.origin) * r.inv_dir;
+    let t0 = (bmin - r.origin_lo) * r.inv_dir;
+    let t1 = (bmax - r.origin_hi) * r.inv_dir;
     let tn = select(t0, t1, r.neg);
-    var tf = select(t1, t0, r.neg);
-    // A parallel axis whose slab holds the origin (even on a plane) never exits.
-    tf = select(tf, vec3<f32>(FAR_BIG), r.parallel & (tf >= vec3<f32>(0.0)));
+    let tf = select(t1, t0, r.neg);
     let near = max(max(tn.x, tn.y), max(tn.z, 0.0));
     let far = min(min(min(tf.x, tf.y), tf.z) * BOX_TFAR_SCALE, tmax);
     return select(-1.0, near, near <= far);
