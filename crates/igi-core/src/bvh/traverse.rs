@@ -148,13 +148,13 @@ impl TraceRay {
     }
 }
 
-/// Slab test. Returns the entry distance (>= 0) when the box is hit within [0, tmax],
-/// -1 otherwise. The entry plane of each axis is chosen by the sign of the direction
-/// (not by min/max of both planes), so an inverted empty box (min = +inf, max = -inf)
-/// enters at +inf and leaves at -inf: never hit. Parallel axes need no case of their
-/// own: their planes are measured from the moved origins (see [`DIR_EPS`]).
+/// Slab test: the (entry, exit) distances of a box clipped to [0, tmax]; the box is hit
+/// when entry <= exit. The entry plane of each axis is chosen by the sign of the
+/// direction (not by min/max of both planes), so an inverted empty box (min = +inf,
+/// max = -inf) enters at +inf and leaves at -inf: never hit. Parallel axes need no case
+/// of their own: their planes are measured from the moved origins (see [`DIR_EPS`]).
 #[inline]
-fn box_near(min: [f32; 3], max: [f32; 3], r: &TraceRay, tmax: f32) -> f32 {
+fn box_span(min: [f32; 3], max: [f32; 3], r: &TraceRay, tmax: f32) -> (f32, f32) {
     let t0 = (Vec3::from(min) - r.origin_lo) * r.inv_dir;
     let t1 = (Vec3::from(max) - r.origin_hi) * r.inv_dir;
     let pick = |k: usize| {
@@ -169,11 +169,25 @@ fn box_near(min: [f32; 3], max: [f32; 3], r: &TraceRay, tmax: f32) -> f32 {
     let (nz, fz) = pick(2);
     let near = nx.max(ny).max(nz.max(0.0));
     let far = (fx.min(fy).min(fz) * BOX_TFAR_SCALE).min(tmax);
+    (near, far)
+}
+
+/// The entry distance (>= 0) of a box hit within [0, tmax], -1 otherwise.
+#[inline]
+fn box_near(min: [f32; 3], max: [f32; 3], r: &TraceRay, tmax: f32) -> f32 {
+    let (near, far) = box_span(min, max, r, tmax);
     if near <= far {
         near
     } else {
         -1.0
     }
+}
+
+/// Whether a box is hit within [0, tmax] (any hit needs no distance).
+#[inline]
+fn box_hit(min: [f32; 3], max: [f32; 3], r: &TraceRay, tmax: f32) -> bool {
+    let (near, far) = box_span(min, max, r, tmax);
+    near <= far
 }
 
 /// Watertight ray-triangle test (Woop, Benthin, Wald, JCGT 2(1), 2013), two-sided.
@@ -353,26 +367,25 @@ pub(crate) fn trace_any(bvh: &Bvh, origin: Vec3, dir: Vec3, tmax: f32) -> bool {
     let mut node = 0u32;
     loop {
         let n = &bvh.nodes[node as usize];
-        let [c0, c1] = children(n, &r, tmax);
         let mut next = NO_HIT;
-        if c0.0 >= 0.0 {
-            if c0.2 > 0 {
-                if leaf_any(bvh, c0.1, c0.2, &r, tmax) {
+        if box_hit(n.a_min, n.a_max, &r, tmax) {
+            if n.a_count > 0 {
+                if leaf_any(bvh, n.a_index, n.a_count, &r, tmax) {
                     return true;
                 }
             } else {
-                next = c0.1;
+                next = n.a_index;
             }
         }
-        if c1.0 >= 0.0 {
-            if c1.2 > 0 {
-                if leaf_any(bvh, c1.1, c1.2, &r, tmax) {
+        if box_hit(n.b_min, n.b_max, &r, tmax) {
+            if n.b_count > 0 {
+                if leaf_any(bvh, n.b_index, n.b_count, &r, tmax) {
                     return true;
                 }
             } else if next == NO_HIT {
-                next = c1.1;
+                next = n.b_index;
             } else {
-                stack[sp] = c1.1;
+                stack[sp] = n.b_index;
                 sp += 1;
             }
         }
