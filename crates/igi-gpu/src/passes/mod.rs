@@ -95,25 +95,22 @@ impl GatherPipelines {
     }
 }
 
-/// VPL lanes per pixel the indirect pass is built for: `main` (one) and `main_coherent`.
-pub const LANE_CHOICES: [u32; 2] = [1, COHERENT_LANES];
-
-/// The lanes per pixel of `main_coherent` (indirect.wgsl): a warp holds one lane of 32
-/// pixels of one interleaving subset.
-pub const COHERENT_LANES: u32 = 8;
+/// VPL lanes per pixel the indirect pass is built for: `main` (one) and `main_coherent`
+/// (more: a warp holds one lane of 32 pixels of one interleaving subset).
+pub const LANE_CHOICES: [u32; 3] = [1, 4, 8];
 
 /// Lanes per pixel of the indirect pass at the mirrored hits (the mirror indirect stage,
 /// over the list of those pixels): few pixels see a mirror (18000 of 480000 in the
 /// conference room), so their VPL loops are split over 8 threads; one lane on a software
 /// adapter. 8 beat 32 and 1 on the H200 at 800 x 600 and 1920 x 1080, canonical and
-/// interleaved (docs/PERFORMANCE.md, attempts 17 and 26). `IGI_MIRROR_LANES` (1, 8 or
-/// 32) overrides it, for measurements.
+/// interleaved (docs/PERFORMANCE.md, attempts 17 and 26). `IGI_MIRROR_LANES` (1, 2, 4, 8
+/// or 32) overrides it, for measurements.
 pub fn mirror_lanes(software: bool) -> u32 {
     if let Some(l) = std::env::var("IGI_MIRROR_LANES")
         .ok()
         .and_then(|v| v.parse::<u32>().ok())
     {
-        if [1, 8, 32].contains(&l) {
+        if [1, 2, 4, 8, 32].contains(&l) {
             return l;
         }
     }
@@ -125,14 +122,26 @@ pub fn mirror_lanes(software: bool) -> u32 {
 }
 
 /// Below this many pixels of the indirect term each pixel's VPLs are split over 8 lanes
-/// (`main_coherent`, a warp holding one lane of 32 pixels of one interleaving subset).
-/// Measured on the H200 (docs/PERFORMANCE.md, attempt 27): 8 lanes beat one lane from the
-/// downsampled frames (30000 pixels at 800 x 600) up to the full 800 x 600 frame (480000
-/// pixels: canonical indirect 22.1 -> 17.4 ms; one lane per pixel is under two waves of
-/// workgroups there, ending in a long tail), and lose a little at the full 1920 x 1080
-/// frame (2.07 M pixels: 64.7 against 63.7 ms). `IGI_VPL_LANES` (1 or 8) overrides the
-/// choice, for measurements.
-pub const LANES_BELOW_PIXELS: u32 = 1_000_000;
+/// (`main_coherent`, a warp holding one lane of 32 pixels of one interleaving subset),
+/// from it on over 4. Measured on the H200, conference room, 180 VPLs (docs/PERFORMANCE.md,
+/// attempt 37; indirect stage in ms for 1 / 2 / 4 / 8 lanes):
+///
+/// | indirect term | pixels | 1 | 2 | 4 | 8 |
+/// |---|---|---|---|---|---|
+/// | iv+ds+il 800 x 600 | 30,000 | 1.19 | 0.47 | 0.296 | **0.262** |
+/// | iv+ds 800 x 600 | 30,000 | 7.58 | 3.69 | 2.06 | **1.45** |
+/// | iv+ds+il 1920 x 1080 | 129,600 | 1.57 | 0.83 | **0.651** | 0.689 |
+/// | iv+ds 1920 x 1080 | 129,600 | 8.91 | 4.95 | 3.55 | **3.28** |
+/// | canonical 800 x 600 | 480,000 | 18.46 | 13.59 | **12.59** | 13.23 |
+/// | canonical 1920 x 1080 | 2,073,600 | 48.23 | 49.60 | **46.27** | 49.22 |
+///
+/// (iv at full resolution behaves like canonical.) The threshold sits between the two
+/// sizes measured where 4 and 8 lanes trade places, so that the worse choice there costs
+/// least (0.04 ms at iv+ds+il 1080p). One lane per pixel (`main`, 8 x 8 pixels a
+/// workgroup, not grouped by subset) loses everywhere on a GPU, and 2 lanes never win,
+/// so the pass is not built for them. `IGI_VPL_LANES` (1, 4 or 8) overrides the choice,
+/// for measurements.
+pub const LANES_BELOW_PIXELS: u32 = 200_000;
 
 /// The lanes a gathering pass uses over `pixels` pixels; always one on a software
 /// adapter, which has few threads to fill and whose workgroup barriers are slow.
@@ -145,15 +154,17 @@ pub fn lanes_for(pixels: u32, software: bool) -> u32 {
             return l;
         }
     }
-    if software || pixels >= LANES_BELOW_PIXELS {
+    if software {
         1
+    } else if pixels < LANES_BELOW_PIXELS {
+        8
     } else {
-        COHERENT_LANES
+        4
     }
 }
 
 /// A gathering pass built for each entry of [`LANE_CHOICES`]: entry point `main` (one
-/// thread per pixel, 8 x 8 per workgroup) and `main_coherent` (8 lanes per pixel, 256
+/// thread per pixel, 8 x 8 per workgroup) and `main_coherent` (n lanes per pixel, 32 n
 /// threads per workgroup), each with and without imperfect visibility.
 pub(crate) struct LanePipelines {
     by_lanes: Vec<GatherPipelines>,
@@ -169,8 +180,15 @@ impl LanePipelines {
             by_lanes: LANE_CHOICES
                 .iter()
                 .map(|&lanes| {
-                    let entry = if lanes == 1 { "main" } else { "main_coherent" };
-                    GatherPipelines::new(device, name, entry, layouts, &[])
+                    if lanes == 1 {
+                        GatherPipelines::new(device, name, "main", layouts, &[])
+                    } else {
+                        let constants = [
+                            ("COHERENT_LANES", lanes as f64),
+                            ("COHERENT_GROUP", (32 * lanes) as f64),
+                        ];
+                        GatherPipelines::new(device, name, "main_coherent", layouts, &constants)
+                    }
                 })
                 .collect(),
         }
@@ -188,7 +206,7 @@ impl LanePipelines {
     ) -> (&wgpu::ComputePipeline, [u32; 3]) {
         let index = LANE_CHOICES.iter().position(|&l| l == lanes).unwrap_or(0);
         let pipeline = self.by_lanes[index].get(imperfect_visibility);
-        if lanes == COHERENT_LANES {
+        if lanes > 1 {
             // main_coherent: 8 x 4 interleaving tiles per workgroup, one subset each.
             let (n, m) = (interleave.0.max(1), interleave.1.max(1));
             (

@@ -43,16 +43,19 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     store_irradiance(gid.x, gid.y, pixel_sum(gid.x, gid.y, 0u, 1u));
 }
 
-// Each pixel's VPLs split over 8 threads (lanes), the threads of a warp on 32 pixels of
-// one interleaving subset and one lane: they trace to the same VPL at each step of the
-// loop (rays that end at one point, from neighbouring pixels of the subset; warps that
-// held the 8 lanes of 4 neighbouring pixels traced to 32 different VPLs, which was up
-// to 1.6x slower, docs/PERFORMANCE.md attempt 27). A workgroup is 32 pixels x 8 lanes:
-// the pixels at the same place of 8 x 4 neighbouring interleaving tiles (the same subset
+// Each pixel's VPLs split over COHERENT_LANES threads (lanes: 4 or 8, set by the
+// pipeline, passes::lanes_for), the threads of a warp on 32 pixels of one interleaving
+// subset and one lane: they trace to the same VPL at each step of the loop (rays that
+// end at one point, from neighbouring pixels of the subset; warps that held the 8 lanes
+// of 4 neighbouring pixels traced to 32 different VPLs, which was up to 1.6x slower,
+// docs/PERFORMANCE.md attempt 27). A workgroup is 32 pixels x COHERENT_LANES lanes: the
+// pixels at the same place of 8 x 4 neighbouring interleaving tiles (the same subset
 // with the regular pattern; the irregular one permutes subsets per tile, which costs
 // coherence, not correctness: attempt 30), and group.z is that place in the tile. The
-// lanes' sums
-// are added in lane order: the same image as one lane per pixel, bit for bit.
+// lanes' sums are added in lane order.
+override COHERENT_LANES: u32 = 8u;
+// Threads of a main_coherent workgroup: 32 x COHERENT_LANES (set with it).
+override COHERENT_GROUP: u32 = 256u;
 var<workgroup> coherent_sums: array<vec4<f32>, 256>;
 
 // The sum of pixel p's `lanes` lane sums in lane order (lane k of the workgroup's
@@ -65,7 +68,7 @@ fn lanes_total(p: u32, pixels: u32, lanes: u32) -> vec3<f32> {
     return total;
 }
 
-@compute @workgroup_size(256)
+@compute @workgroup_size(COHERENT_GROUP)
 fn main_coherent(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) l: u32) {
     let n = params.interleave_n;
     let m = params.interleave_m;
@@ -76,12 +79,12 @@ fn main_coherent(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocat
     let inside = x < params.low_width && y < params.low_height;
     var sum = vec3<f32>(0.0);
     if (inside) {
-        sum = pixel_sum(x, y, lane, 8u);
+        sum = pixel_sum(x, y, lane, COHERENT_LANES);
     }
     coherent_sums[l] = vec4<f32>(sum, 0.0);
     workgroupBarrier();
     if (inside && lane == 0u) {
-        store_irradiance(x, y, lanes_total(p, 32u, 8u));
+        store_irradiance(x, y, lanes_total(p, 32u, COHERENT_LANES));
     }
 }
 
