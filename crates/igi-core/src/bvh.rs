@@ -71,7 +71,8 @@ pub const SAH_INTERSECT_COST: f32 = 1.0;
 /// | 48..60 | `b_max`   | child b: box maximum                                         |
 /// | 60..64 | `b_count` | child b: 0 = interior node, n > 0 = leaf                     |
 ///
-/// Leaf triangles are BVH slots `index .. index + count` of [`Bvh::tri_verts`]. An empty
+/// Child a is the one of larger box surface area (any-hit walks visit it first, see
+/// `build`). Leaf triangles are BVH slots `index .. index + count` of [`Bvh::tri_verts`]. An empty
 /// child (the second child of a root that is a single leaf, both children of the BVH of
 /// no triangles) has min = +inf, max = -inf, count 1, index 0: its box is never hit.
 #[repr(C)]
@@ -109,6 +110,12 @@ impl BvhChild {
 
     pub fn is_leaf(&self) -> bool {
         self.count > 0
+    }
+
+    /// Half the surface area of the child's box (0 for an empty or inverted one).
+    pub fn half_area(&self) -> f32 {
+        let e = (self.max - self.min).max(Vec3::ZERO);
+        e.x * e.y + e.y * e.z + e.z * e.x
     }
 }
 

@@ -64,6 +64,11 @@ fn check_structure(bvh: &Bvh, tris: &[[Vec3; 3]]) {
         assert!(!node_seen[node as usize], "node {node} reached twice");
         node_seen[node as usize] = true;
         let nd = bvh.nodes[node as usize];
+        // Any-hit walks visit child a first: the larger box (attempt 41).
+        assert!(
+            nd.a().half_area() >= nd.b().half_area(),
+            "node {node}: child a is the smaller"
+        );
         for c in [nd.a(), nd.b()] {
             if c.min.x > c.max.x {
                 assert_eq!((c.index, c.count), (0, 1), "empty child");
