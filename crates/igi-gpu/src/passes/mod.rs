@@ -254,12 +254,12 @@ pub(crate) fn pass_layout(
 ///   it). With wgpu's loop bound a loop that did not end would end early with a wrong
 ///   result; without it, it hangs the GPU. Both are bugs, which the tests would show.
 /// * Every index into a function or workgroup array is in bounds: the traversal stack
-///   holds at most `STACK_SIZE` entries (proved at `igi_core::bvh::STACK_SIZE`, checked
-///   by a test), the irregular pattern's permutation has n x m <= 64 entries (the frame
-///   refuses larger interleaving), the Halton tables are indexed modulo 64, and the
-///   workgroup sums by invocation indices below the workgroup size. Storage buffers stay
-///   bounds-checked by the device itself on Vulkan (robust buffer access, which wgpu
-///   enables where the device has it).
+///   holds at most `STACK_SIZE` = `igi_core::bvh::MAX_DEPTH` entries (proved at
+///   `MAX_DEPTH`, checked by a test), the irregular pattern's permutation has n x m <= 64
+///   entries (the frame refuses larger interleaving), the Halton tables are indexed
+///   modulo 64, and the workgroup sums by invocation indices below the workgroup size.
+///   Storage buffers stay bounds-checked by the device itself on Vulkan (robust buffer
+///   access, which wgpu enables where the device has it).
 pub const TRUSTED_CHECKS: wgpu::ShaderRuntimeChecks = {
     let mut checks = wgpu::ShaderRuntimeChecks::checked();
     checks.bounds_checks = false;

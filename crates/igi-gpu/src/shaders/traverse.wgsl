@@ -63,7 +63,7 @@ struct TraceRay {
     neg: vec3<bool>,
     // |dir| < DIR_EPS: the ray is parallel to that axis' slab (box_crossed).
     parallel: vec3<bool>,
-    // The origins box_near measures entry (origin_lo) and exit (origin_hi) planes from:
+    // The origins box_span measures entry (origin_lo) and exit (origin_hi) planes from:
     // `origin`, moved by the slack of PARALLEL_SLACK along parallel axes.
     origin_lo: vec3<f32>,
     origin_hi: vec3<f32>,
