@@ -782,10 +782,7 @@ fn stats(triangles: usize, nodes: usize, t: Tally, root_area: f32, start: Instan
 /// The same statistics by walking the finished tree (tests check both agree).
 #[cfg(test)]
 pub(super) fn stats_by_walk(bvh: &Bvh) -> BuildStats {
-    let area = |c: &BvhChild| {
-        let e = (c.max - c.min).max(Vec3::ZERO);
-        e.x * e.y + e.y * e.z + e.z * e.x
-    };
+    let area = BvhChild::half_area;
     let (lo, hi) = bvh.bounds();
     let root_area = area(&BvhChild {
         min: lo,

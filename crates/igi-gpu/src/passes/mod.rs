@@ -183,10 +183,7 @@ impl LanePipelines {
                     if lanes == 1 {
                         GatherPipelines::new(device, name, "main", layouts, &[])
                     } else {
-                        let constants = [
-                            ("COHERENT_LANES", lanes as f64),
-                            ("COHERENT_GROUP", (32 * lanes) as f64),
-                        ];
+                        let constants = [("COHERENT_LANES", lanes as f64)];
                         GatherPipelines::new(device, name, "main_coherent", layouts, &constants)
                     }
                 })

@@ -54,8 +54,6 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
 // coherence, not correctness: attempt 30), and group.z is that place in the tile. The
 // lanes' sums are added in lane order.
 override COHERENT_LANES: u32 = 8u;
-// Threads of a main_coherent workgroup: 32 x COHERENT_LANES (set with it).
-override COHERENT_GROUP: u32 = 256u;
 var<workgroup> coherent_sums: array<vec4<f32>, 256>;
 
 // The sum of pixel p's `lanes` lane sums in lane order (lane k of the workgroup's
@@ -68,7 +66,7 @@ fn lanes_total(p: u32, pixels: u32, lanes: u32) -> vec3<f32> {
     return total;
 }
 
-@compute @workgroup_size(COHERENT_GROUP)
+@compute @workgroup_size(32u * COHERENT_LANES)
 fn main_coherent(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) l: u32) {
     let n = params.interleave_n;
     let m = params.interleave_m;
