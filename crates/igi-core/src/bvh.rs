@@ -26,7 +26,8 @@ use glam::Vec3;
 use crate::scene::Triangle;
 
 pub use traverse::{
-    brute_force_any, brute_force_closest, offset_ray_origin, shadow_segment, Hit, NO_HIT,
+    brute_force_any, brute_force_closest, offset_floor, offset_ray_origin, shadow_segment, Hit,
+    NO_HIT, OFFSET_FLOOR_ULPS,
 };
 
 /// Deepest level at which the builder still makes an interior node; a node range that

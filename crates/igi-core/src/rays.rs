@@ -12,9 +12,9 @@
 //! | 28 | tmax | segment length for shadow rays; 3.4e38 ("infinity") for closest-hit rays |
 //!
 //! Surface points are offset with the method of Wächter and Binder (Ray Tracing Gems,
-//! ch. 6, [`crate::bvh::offset_ray_origin`]): a shadow segment runs from x moved off its
-//! surface towards y, to y moved off its surface towards x, so neither end surface can
-//! occlude it.
+//! ch. 6, [`crate::bvh::offset_ray_origin`]) and at least the scene's offset floor: a
+//! shadow segment runs from x moved off its surface towards y, to y moved off its surface
+//! towards x, so neither end surface can occlude it.
 
 use crate::bvh::offset_ray_origin;
 use crate::sampling::hash_u32;
@@ -158,13 +158,17 @@ fn surface_points(scene: &Scene, count: usize, seed: u32) -> Vec<(Vec3, Vec3)> {
 pub fn random_segments(scene: &Scene, count: usize, seed: u32) -> Vec<RayRecord> {
     let a = surface_points(scene, count, seed);
     let b = surface_points(scene, count, seed.wrapping_add(1));
+    let floor = scene.ray_offset_floor();
     a.iter()
         .zip(&b)
         .map(|(&(pa, na), &(pb, nb))| {
             let d = pb - pa;
             let na = if na.dot(d) < 0.0 { -na } else { na };
             let nb = if nb.dot(d) > 0.0 { -nb } else { nb };
-            RayRecord::segment(offset_ray_origin(pa, na), offset_ray_origin(pb, nb))
+            RayRecord::segment(
+                offset_ray_origin(pa, na, floor),
+                offset_ray_origin(pb, nb, floor),
+            )
         })
         .collect()
 }
@@ -173,6 +177,7 @@ pub fn random_segments(scene: &Scene, count: usize, seed: u32) -> Vec<RayRecord>
 /// (origin moved off the surface on the side the ray leaves to).
 pub fn random_rays(scene: &Scene, count: usize, seed: u32) -> Vec<RayRecord> {
     let points = surface_points(scene, count, seed);
+    let floor = scene.ray_offset_floor();
     let mut rng = Uniform {
         state: hash_u32(seed ^ 0xd1ec),
     };
@@ -182,7 +187,7 @@ pub fn random_rays(scene: &Scene, count: usize, seed: u32) -> Vec<RayRecord> {
             let d = crate::sampling::uniform_sphere(rng.next(), rng.next());
             let n = if n.dot(d) < 0.0 { -n } else { n };
             RayRecord {
-                origin: offset_ray_origin(p, n).to_array(),
+                origin: offset_ray_origin(p, n, floor).to_array(),
                 tmin: 0.0,
                 dir: d.to_array(),
                 tmax: RAY_INFINITY,

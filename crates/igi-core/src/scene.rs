@@ -108,6 +108,13 @@ impl Scene {
         (hi - lo).length()
     }
 
+    /// The least distance ray origins move off surfaces in this scene
+    /// ([`crate::bvh::offset_floor`] of its bounds).
+    pub fn ray_offset_floor(&self) -> f32 {
+        let (lo, hi) = self.bounds();
+        crate::bvh::offset_floor(lo, hi)
+    }
+
     /// Total power of all lights (RGB).
     pub fn total_power(&self) -> Vec3 {
         self.lights.iter().map(|l| l.power()).sum()

@@ -73,6 +73,7 @@ pub fn shoot_vpls(
     base: u32,
 ) -> Vec<CpuVpl> {
     let halton = |dim: usize, index: u32| scrambled_radical_inverse(perms, dim, index);
+    let floor = scene.ray_offset_floor();
     let weight = |l: usize| 4.0 * PI * scene.lights[l].intensity.element_sum();
     let power_sum: f32 = (0..scene.lights.len()).map(weight).sum();
     let mut out = vec![];
@@ -133,7 +134,7 @@ pub fn shoot_vpls(
             } else {
                 break;
             }
-            origin = offset_ray_origin(s.position, s.geometric_normal);
+            origin = offset_ray_origin(s.position, s.geometric_normal, floor);
             dim += 3;
         }
     }

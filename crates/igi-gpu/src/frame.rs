@@ -122,6 +122,8 @@ pub struct Renderer {
     light_power_sum: f32,
     total_power: [f32; 3],
     diagonal: f32,
+    /// The scene's [`Scene::ray_offset_floor`] (params.ray_offset_floor).
+    ray_offset_floor: f32,
     /// Paths per frame for (seed, vpls, bounces, mirror depth), from the pilot run.
     path_cache: Option<((u32, u32, u32, u32), u32)>,
     /// Whether any material has a mirror part (else the mirror stage is skipped).
@@ -204,6 +206,7 @@ impl Renderer {
             light_power_sum: light_powers(&scene.lights).0,
             total_power: light_powers(&scene.lights).1,
             diagonal: scene.diagonal(),
+            ray_offset_floor: scene.ray_offset_floor(),
             path_cache: None,
             counting: false,
             software,
@@ -533,7 +536,8 @@ impl Renderer {
             jitter_y: jitter.1,
             count_rays: 0,
             depth_scale: 1.0 / self.diagonal.max(f32::MIN_POSITIVE),
-            _pad: [0; 3],
+            ray_offset_floor: self.ray_offset_floor,
+            _pad: [0; 2],
         }
     }
 
@@ -751,8 +755,8 @@ impl Renderer {
                 return None;
             }
             Some(igi_core::rays::RayRecord::segment(
-                offset_ray_origin(x, ng),
-                offset_ray_origin(y, ny),
+                offset_ray_origin(x, ng, self.ray_offset_floor),
+                offset_ray_origin(y, ny, self.ray_offset_floor),
             ))
         };
         let all: usize = pixels

@@ -108,7 +108,8 @@ pub struct Vpl {
 /// | 168 | jitter_y: f32 | |
 /// | 172 | count_rays: u32 | 1 in a frame that counts its rays (scene binding 5) |
 /// | 176 | depth_scale: f32 | 1 / scene diagonal: the depth buffer's unit |
-/// | 180 | _pad: [u32; 3] | |
+/// | 180 | ray_offset_floor: f32 | least move of a ray origin off its surface (`Scene::ray_offset_floor`) |
+/// | 184 | _pad: [u32; 2] | |
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct FrameParams {
@@ -147,7 +148,8 @@ pub struct FrameParams {
     pub jitter_y: f32,
     pub count_rays: u32,
     pub depth_scale: f32,
-    pub _pad: [u32; 3],
+    pub ray_offset_floor: f32,
+    pub _pad: [u32; 2],
 }
 
 /// Parameters of the viewer's display pass (uniform buffer, 48 bytes; `shaders/display.wgsl`).

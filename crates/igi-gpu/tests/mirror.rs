@@ -39,7 +39,8 @@ fn irradiance(
     ns: Vec3,
     with_vpls: bool,
 ) -> Vec3 {
-    let origin = offset_ray_origin(p, ng);
+    let floor = scene.ray_offset_floor();
+    let origin = offset_ray_origin(p, ng, floor);
     let mut e = Vec3::ZERO;
     for l in &scene.lights {
         let d = l.position - p;
@@ -60,7 +61,7 @@ fn irradiance(
             }
             let t = ((dist - 0.8 * m) / (0.4 * m)).clamp(0.0, 1.0);
             let g = cx * cy * t * t * (3.0 - 2.0 * t) / dist2;
-            let end = offset_ray_origin(y, ny);
+            let end = offset_ray_origin(y, ny, floor);
             if g > 0.0 && !bvh.trace_any(origin, end - origin, 1.0) {
                 e += Vec3::from(v.flux) * Vec3::from(v.albedo) * (g / PI);
             }
@@ -114,7 +115,7 @@ fn chain_radiance(
         if dir.dot(s.geometric_normal) <= 0.0 {
             dir = reflect(dir, s.geometric_normal);
         }
-        origin = offset_ray_origin(s.position, s.geometric_normal);
+        origin = offset_ray_origin(s.position, s.geometric_normal, scene.ray_offset_floor());
     }
     (radiance, gathered)
 }

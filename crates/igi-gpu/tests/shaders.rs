@@ -122,7 +122,8 @@ fn host_structs_match_wgsl() {
             jitter_x,
             jitter_y,
             count_rays,
-            depth_scale
+            depth_scale,
+            ray_offset_floor
         ]
     );
 }

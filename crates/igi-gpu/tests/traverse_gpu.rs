@@ -23,7 +23,7 @@ const KERNEL: &str = r#"
 struct TestRay {
     origin: vec3<f32>, tmax: f32,
     dir: vec3<f32>, _pad0: f32,
-    normal: vec3<f32>, _pad1: f32,
+    normal: vec3<f32>, floor: f32,
 }
 
 struct TestResult {
@@ -45,7 +45,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     var res: TestResult;
     res.hit = trace_closest(r.origin, r.dir, r.tmax);
     res.any_hit = select(0u, 1u, trace_any(r.origin, r.dir, r.tmax));
-    res.offset = offset_ray_origin(r.origin, r.normal);
+    res.offset = offset_ray_origin(r.origin, r.normal, r.floor);
     results[i] = res;
 }
 "#;
@@ -59,7 +59,8 @@ struct TestRay {
     dir: [f32; 3],
     _pad0: f32,
     normal: [f32; 3],
-    _pad1: f32,
+    /// The offset floor to test offset_ray_origin with.
+    floor: f32,
 }
 
 /// `TestResult` of the kernel: 48 bytes (hit 0..16, any_hit 16..20, offset 32..44).
@@ -145,7 +146,8 @@ fn rays(r: &mut Pcg64, center: Vec3, ring: &[Vec3]) -> Vec<(TestRay, Kind)> {
                 dir: d.to_array(),
                 _pad0: 0.0,
                 normal: n.to_array(),
-                _pad1: 0.0,
+                // No floor, or a power of two (as igi_core::bvh::offset_floor makes).
+                floor: [0.0, 1.0 / 256.0, 0.0625][r.random_range(0..3)],
             },
             kind,
         ));
@@ -275,7 +277,7 @@ fn gpu_traversal_matches_cpu() {
         }
 
         // The ray offset: bit for bit.
-        let off = offset_ray_origin(o, Vec3::from(ray.normal));
+        let off = offset_ray_origin(o, Vec3::from(ray.normal), ray.floor);
         if off.to_array().map(f32::to_bits) != res.offset.map(f32::to_bits) {
             fail(format!("offset: CPU {off}, GPU {:?}", res.offset));
         }

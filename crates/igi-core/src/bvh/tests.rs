@@ -509,7 +509,7 @@ fn offset_origin_never_hits_its_own_triangle() {
             for _ in 0..10 {
                 let p = point_on(&mut r, &t);
                 for side in [n, -n] {
-                    let o = offset_ray_origin(p, side);
+                    let o = offset_ray_origin(p, side, floor_of(&[t]));
                     // Directions down to 1 degree above the surface.
                     let d = hemisphere(&mut r, side, 0.02);
                     grazing += usize::from(d.dot(side) < 0.1);
@@ -522,6 +522,117 @@ fn offset_origin_never_hits_its_own_triangle() {
         }
     }
     assert!(grazing > 1000);
+}
+
+/// A floor of two huge triangles near y = 0 (the conference room's: 2,600 x 1,700 units
+/// at y = -1.57), so that a point on it has a small y but far vertices: Wächter and
+/// Binder's offset (256 ulps of each coordinate, 3e-5 here) is smaller than the triangle
+/// test's error from across the room (~1e-4). With the scene's offset floor, segments
+/// between the floor and points above it are not occluded by the floor at either end,
+/// and real occluders near an end still occlude.
+#[test]
+fn segments_ending_on_a_huge_floor_are_not_occluded_by_it() {
+    let y = -1.57216f32;
+    let (x0, x1, z0, z1) = (-946.888f32, 1653.25f32, -1016.1f32, 668.489f32);
+    let floor = [
+        [
+            Vec3::new(x0, y, z0),
+            Vec3::new(x0, y, z1),
+            Vec3::new(x1, y, z0),
+        ],
+        [
+            Vec3::new(x0, y, z1),
+            Vec3::new(x1, y, z1),
+            Vec3::new(x1, y, z0),
+        ],
+    ];
+    let mut r = rng(13);
+    let mut tris: Vec<[Vec3; 3]> = floor.to_vec();
+    // Small occluders 0.5 above the floor (a table top's corner).
+    let mut plates = vec![];
+    for _ in 0..64 {
+        let c = Vec3::new(r.random_range(x0..x1), y + 0.5, r.random_range(z0..z1));
+        tris.push([
+            c + Vec3::new(-1.0, 0.0, -1.0),
+            c + Vec3::new(1.0, 0.0, -1.0),
+            c + Vec3::new(0.0, 0.0, 1.5),
+        ]);
+        plates.push(c);
+    }
+    let offset = floor_of(&tris);
+    assert_eq!(
+        offset,
+        1.0 / 256.0,
+        "32 ulps of 1,653 (0.0032), up to a power of two"
+    );
+    let up = Vec3::Y;
+    // Ends of the two segments the CPU check of the conference room found occluded by
+    // the floor (docs/PERFORMANCE.md attempt 47): at the origin, and at the far end.
+    let x = Vec3::new(676.25275, y, 182.99976);
+    let d = Vec3::new(-0.85514784, 0.4653153, 0.22848178);
+    let mut pairs = vec![(x, up, x + 1400.8771 * d, -d)];
+    let o = Vec3::new(-46.592667, 415.80115, 591.5684);
+    let d = Vec3::new(-0.16887122, -0.25045708, -0.95328575);
+    let e = o + 1666.4464 * d;
+    pairs.push((o, d, Vec3::new(e.x, y, e.z), up));
+    // And random ones: a floor point and a point in the room above it.
+    for i in 0..4000 {
+        let p = point_on(&mut r, &floor[i % 2]);
+        let h = Vec3::new(
+            r.random_range(x0..x1),
+            r.random_range(1.0..700.0),
+            r.random_range(z0..z1),
+        );
+        pairs.push((Vec3::new(p.x, y, p.z), up, h, -up));
+    }
+    let floor_bvh = Bvh::build_from_vertices(&floor);
+    for &(a, na, b, nb) in &pairs {
+        for (a, na, b, nb) in [(a, na, b, nb), (b, nb, a, na)] {
+            let (o, d) = shadow_segment(a, na, b, nb, offset);
+            assert!(
+                !brute_force_any(&floor, o, d, 1.0) && !floor_bvh.trace_any(o, d, 1.0),
+                "segment {a} -> {b} occluded by the floor it ends on"
+            );
+        }
+    }
+    // Real occluders near an end stay occluders: segments from the floor up through a
+    // plate 0.5 above it (1/1000 of the 500-unit segment).
+    let bvh = Bvh::build_from_vertices(&tris);
+    for c in &plates {
+        let x = Vec3::new(c.x, y, c.z + 0.25);
+        let h = Vec3::new(c.x + 1.0, 500.0, c.z + 0.3);
+        for (a, na, b, nb) in [(x, up, h, -up), (h, -up, x, up)] {
+            let (o, d) = shadow_segment(a, na, b, nb, offset);
+            assert!(
+                bvh.trace_any(o, d, 1.0),
+                "segment {a} -> {b} missed the plate at {c}"
+            );
+        }
+    }
+}
+
+#[test]
+fn offset_floor_is_a_power_of_two_above_32_ulps_of_the_largest_coordinate() {
+    let f = |m: f32| offset_floor(Vec3::new(-m, 0.0, 0.0), Vec3::new(0.5 * m, 0.0, 0.0));
+    assert_eq!(f(1.0), 1.0 / 524_288.0, "32 x 2^-24 = 2^-19 exactly");
+    for m in [1e-6f32, 3e-3, 0.7, 1.0, 1653.25, 12_345.0, 3e7] {
+        let x = f(m);
+        assert_eq!(x.to_bits() & 0x007f_ffff, 0, "{x} is a power of two");
+        let least = OFFSET_FLOOR_ULPS * f32::EPSILON * 0.5 * m;
+        assert!(x >= least && x < 2.0 * least, "{x} for m = {m}");
+    }
+    let empty = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+    assert_eq!(offset_floor(empty.0, empty.1), 0.0);
+    assert_eq!(offset_floor(Vec3::ZERO, Vec3::ZERO), 0.0);
+}
+
+/// The bounds of a triangle list, and the offset floor of that "scene".
+fn floor_of(tris: &[[Vec3; 3]]) -> f32 {
+    let (lo, hi) = tris.iter().flatten().fold(
+        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+        |(lo, hi), &v| (lo.min(v), hi.max(v)),
+    );
+    offset_floor(lo, hi)
 }
 
 #[test]
@@ -550,6 +661,7 @@ fn segments_between_facing_planes_are_unoccluded() {
             let q2 = quad(c + gap * n);
             let tris: Vec<[Vec3; 3]> = q1.iter().chain(q2.iter()).copied().collect();
             let bvh = Bvh::build_from_vertices(&tris);
+            let offset = floor_of(&tris);
             // The normals as a renderer has them: from the triangles' own vertices.
             let normal = |t: &[Vec3; 3]| (t[1] - t[0]).cross(t[2] - t[0]).normalize();
             for _ in 0..200 {
@@ -557,18 +669,18 @@ fn segments_between_facing_planes_are_unoccluded() {
                 let t2 = &q2[r.random_range(0..2)];
                 let x = point_on(&mut r, t1);
                 let y = point_on(&mut r, t2);
-                let (o, d) = shadow_segment(x, normal(t1), y, normal(t2));
+                let (o, d) = shadow_segment(x, normal(t1), y, normal(t2), offset);
                 assert!(
                     !bvh.trace_any(o, d, 1.0),
                     "segment {x} -> {y} occluded (gap {gap}, size {size})"
                 );
-                let (o, d) = shadow_segment(y, normal(t2), x, normal(t1));
+                let (o, d) = shadow_segment(y, normal(t2), x, normal(t1), offset);
                 assert!(!bvh.trace_any(o, d, 1.0), "segment {y} -> {x} occluded");
                 // A segment that goes on beyond the far plane must be occluded by it.
                 // Aimed at the inner half of the far quad: the offset of x shifts where a
                 // grazing segment crosses it by up to offset * length / gap.
                 let yc = c + gap * n + 0.5 * (y - c - gap * n);
-                let (o, d) = shadow_segment(x, normal(t1), yc + (yc - x), normal(t2));
+                let (o, d) = shadow_segment(x, normal(t1), yc + (yc - x), normal(t2), offset);
                 assert!(
                     bvh.trace_any(o, d, 1.0),
                     "segment {x} -> {} through the far plane missed it (gap {gap}, size {size})",

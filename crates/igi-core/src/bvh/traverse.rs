@@ -442,11 +442,15 @@ pub fn brute_force_any(triangles: &[[Vec3; 3]], origin: Vec3, dir: Vec3, tmax: f
 /// ulps are too small, move by n_i / 65536 instead. The bits match `offset_ray_origin`
 /// of `traverse.wgsl` exactly (truncating f32 -> i32 conversion, wrapping i32 add).
 ///
-/// Its limit: the offset scales with the hit point, not with the triangle's vertices, so
-/// a point whose coordinate is much smaller than those of the vertices it was
-/// interpolated from (a huge triangle passing near the world origin) carries more error
-/// than the offset covers.
-pub fn offset_ray_origin(p: Vec3, n: Vec3) -> Vec3 {
+/// Then the point moves `floor` further along n ([`offset_floor`] of the scene): the
+/// offset above scales with the hit point, but the triangle test's error scales with the
+/// distance of a triangle's vertices from the ray origin, up to the scene's size. A point
+/// whose coordinates are small while its surface is huge (the conference room's floor:
+/// two triangles 2,600 units wide at y = -1.57) was moved 3e-5 off a plane that a test
+/// from across the room places with an error of ~1e-4: a CPU check against an f64 test
+/// found 4% of a frame's VPL shadow rays occluded by the surface at one of their ends
+/// (docs/PERFORMANCE.md attempt 47), none with the floor.
+pub fn offset_ray_origin(p: Vec3, n: Vec3, floor: f32) -> Vec3 {
     let f = |p: f32, n: f32| {
         if p.abs() < OFFSET_ORIGIN {
             p + OFFSET_FLOAT_SCALE * n
@@ -456,21 +460,42 @@ pub fn offset_ray_origin(p: Vec3, n: Vec3) -> Vec3 {
             f32::from_bits((p.to_bits() as i32).wrapping_add(of) as u32)
         }
     };
-    Vec3::new(f(p.x, n.x), f(p.y, n.y), f(p.z, n.z))
+    Vec3::new(f(p.x, n.x), f(p.y, n.y), f(p.z, n.z)) + floor * n
+}
+
+/// The floor's size in ulps of the scene's largest coordinate magnitude (see
+/// [`offset_floor`]).
+pub const OFFSET_FLOOR_ULPS: f32 = 32.0;
+
+/// The least distance a ray origin moves off its surface ([`offset_ray_origin`]) in a
+/// scene whose coordinates lie in [lo, hi]: [`OFFSET_FLOOR_ULPS`] ulps (2^-24 each) of
+/// the largest coordinate magnitude M, which bounds the translated vertices' magnitude
+/// the triangle test's rounding scales with (|v - o| <= 2 M; its error bound, pbrt-v4's
+/// after Woop et al., is a few gamma(5) of that). Rounded up to a power of two, so that
+/// floor x n is exact and a GPU that fuses the multiply-add gives the CPU's bits. For the
+/// conference room (M = 1,653) it is 2^-8 = 0.0039 units; 0 for an empty scene.
+pub fn offset_floor(lo: Vec3, hi: Vec3) -> f32 {
+    let m = lo.abs().max(hi.abs()).max_element();
+    let x = OFFSET_FLOOR_ULPS * (f32::EPSILON * 0.5) * m;
+    if !(x.is_finite() && x > 0.0) {
+        return 0.0;
+    }
+    f32::from_bits((x.to_bits() + 0x007f_ffff) & 0xff80_0000)
 }
 
 /// The shadow ray of the segment from surface point `x` (geometric normal `nx`) to
 /// surface point `y` (normal `ny`): returns (origin, dir) to trace with tmax = 1.
 ///
-/// Both ends are offset with [`offset_ray_origin`], each along its normal flipped to face
-/// the other point, so that neither surface occludes the segment. The direction is
-/// y' - x', not normalised: t is in units of the segment (t = 1 at y'), which is why
-/// tmax = 1 and why the caller needs no distance. Normals need not be oriented.
-pub fn shadow_segment(x: Vec3, nx: Vec3, y: Vec3, ny: Vec3) -> (Vec3, Vec3) {
+/// Both ends are offset with [`offset_ray_origin`] (and the scene's `floor`), each along
+/// its normal flipped to face the other point, so that neither surface occludes the
+/// segment. The direction is y' - x', not normalised: t is in units of the segment (t = 1
+/// at y'), which is why tmax = 1 and why the caller needs no distance. Normals need not
+/// be oriented.
+pub fn shadow_segment(x: Vec3, nx: Vec3, y: Vec3, ny: Vec3, floor: f32) -> (Vec3, Vec3) {
     let d = y - x;
     let nx = if nx.dot(d) < 0.0 { -nx } else { nx };
     let ny = if ny.dot(d) > 0.0 { -ny } else { ny };
-    let o = offset_ray_origin(x, nx);
-    let e = offset_ray_origin(y, ny);
+    let o = offset_ray_origin(x, nx, floor);
+    let e = offset_ray_origin(y, ny, floor);
     (o, e - o)
 }

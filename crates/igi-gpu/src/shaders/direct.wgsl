@@ -118,7 +118,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         if (dot(dir, s.geometric_normal) <= 0.0) {
             dir = reflect(dir, s.geometric_normal);
         }
-        origin = offset_ray_origin(s.position, s.geometric_normal);
+        origin = offset_ray_origin(s.position, s.geometric_normal, params.ray_offset_floor);
     }
     if (first_walk) {
         count_rays(RAY_PRIMARY, 1u);

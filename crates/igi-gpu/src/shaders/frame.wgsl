@@ -26,7 +26,7 @@ struct FrameParams {
     interleave_m: u32, pattern: u32, seed: u32, accumulate_index: u32,
     upsample_sigma: f32, normal_power: f32, upsample_depth: u32, depth_threshold: f32,
     normal_threshold: f32, jitter_x: f32, jitter_y: f32, count_rays: u32,
-    depth_scale: f32, _pad0: u32, _pad1: u32, _pad2: u32,
+    depth_scale: f32, ray_offset_floor: f32, _pad1: u32, _pad2: u32,
 }
 
 // A virtual point light: 64 bytes, see layout.rs.
@@ -142,7 +142,7 @@ fn count_rays(kind: u32, n: u32) {
 // Irradiance from the point lights at p (shadow rays from the surface to each light).
 fn direct_irradiance(p: vec3<f32>, ng: vec3<f32>, ns: vec3<f32>) -> vec3<f32> {
     var e = vec3<f32>(0.0);
-    let origin = offset_ray_origin(p, ng);
+    let origin = offset_ray_origin(p, ng, params.ray_offset_floor);
     var traced = 0u;
     for (var l = 0u; l < params.light_count; l += 1u) {
         let light = lights[l];

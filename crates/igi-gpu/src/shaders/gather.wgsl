@@ -97,7 +97,7 @@ fn accumulated_irradiance(previous: vec4<f32>, sum: vec3<f32>) -> vec4<f32> {
 
 fn vpl_irradiance(p: vec3<f32>, ng: vec3<f32>, ns: vec3<f32>, first: u32, count: u32, stride: u32) -> vec3<f32> {
     var e = vec3<f32>(0.0);
-    let origin = offset_ray_origin(p, ng);
+    let origin = offset_ray_origin(p, ng, params.ray_offset_floor);
     var traced = 0u;
     for (var k = first; k < count; k += stride) {
         let vpl = vpls[k];
@@ -113,7 +113,7 @@ fn vpl_irradiance(p: vec3<f32>, ng: vec3<f32>, ns: vec3<f32>, first: u32, count:
         if (g <= 0.0) {
             continue;
         }
-        let end = offset_ray_origin(vpl.position, vpl.normal);
+        let end = offset_ray_origin(vpl.position, vpl.normal, params.ray_offset_floor);
         traced += 1u;
         if (trace_shadow(origin, end - origin, 1.0, IMPERFECT_VISIBILITY)) {
             continue;

@@ -352,19 +352,22 @@ fn trace_any(origin: vec3<f32>, dir: vec3<f32>, tmax: f32) -> bool {
 
 // Origin for a ray leaving a surface at p, n the unit geometric normal on the side the
 // ray leaves to: each coordinate moves by 256 n_i ulps of itself (integer add on its
-// bits), or by n_i / 65536 within 1/32 of 0. Bit for bit igi_core::bvh::offset_ray_origin.
-fn offset_ray_origin(p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+// bits), or by n_i / 65536 within 1/32 of 0; then the point moves `floor` further along
+// n (the scene's offset floor, params.ray_offset_floor: igi_core::bvh::offset_floor says
+// why; a power of two, so floor * n is exact and a fused multiply-add changes nothing).
+// Bit for bit igi_core::bvh::offset_ray_origin.
+fn offset_ray_origin(p: vec3<f32>, n: vec3<f32>, floor: f32) -> vec3<f32> {
     let of_i = vec3<i32>(OFFSET_INT_SCALE * n);
     let p_i = bitcast<vec3<f32>>(bitcast<vec3<i32>>(p) + select(of_i, -of_i, p < vec3<f32>(0.0)));
-    return select(p_i, p + OFFSET_FLOAT_SCALE * n, abs(p) < vec3<f32>(OFFSET_ORIGIN));
+    return select(p_i, p + OFFSET_FLOAT_SCALE * n, abs(p) < vec3<f32>(OFFSET_ORIGIN)) + floor * n;
 }
 
 // Shadow ray from surface point x (normal nx) to surface point y (normal ny), both ends
 // offset along their normals turned toward the other point. Trace it with tmax = 1: dir
 // is y' - x', not normalised, so t is in units of the segment.
-fn shadow_segment(x: vec3<f32>, nx: vec3<f32>, y: vec3<f32>, ny: vec3<f32>) -> ShadowSegment {
+fn shadow_segment(x: vec3<f32>, nx: vec3<f32>, y: vec3<f32>, ny: vec3<f32>, floor: f32) -> ShadowSegment {
     let d = y - x;
-    let ox = offset_ray_origin(x, select(nx, -nx, dot(nx, d) < 0.0));
-    let oy = offset_ray_origin(y, select(ny, -ny, dot(ny, d) > 0.0));
+    let ox = offset_ray_origin(x, select(nx, -nx, dot(nx, d) < 0.0), floor);
+    let oy = offset_ray_origin(y, select(ny, -ny, dot(ny, d) > 0.0), floor);
     return ShadowSegment(ox, oy - ox);
 }

@@ -123,7 +123,7 @@ fn shoot(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups)
         } else {
             break;
         }
-        origin = offset_ray_origin(s.position, s.geometric_normal);
+        origin = offset_ray_origin(s.position, s.geometric_normal, params.ray_offset_floor);
         dim += 3u;
     }
     count_rays(RAY_PARTICLE, traced);
