@@ -448,7 +448,7 @@ pub fn brute_force_any(triangles: &[[Vec3; 3]], origin: Vec3, dir: Vec3, tmax: f
 /// whose coordinates are small while its surface is huge (the conference room's floor:
 /// two triangles 2,600 units wide at y = -1.57) was moved 3e-5 off a plane that a test
 /// from across the room places with an error of ~1e-4: a CPU check against an f64 test
-/// found 4% of a frame's VPL shadow rays occluded by the surface at one of their ends
+/// found 2.3% of a frame's VPL shadow rays occluded by the surface at one of their ends
 /// (docs/PERFORMANCE.md attempt 47), none with the floor.
 pub fn offset_ray_origin(p: Vec3, n: Vec3, floor: f32) -> Vec3 {
     let f = |p: f32, n: f32| {
