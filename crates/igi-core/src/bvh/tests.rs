@@ -323,6 +323,40 @@ fn depth_cap_makes_a_leaf_and_stays_correct() {
     assert!(full.build_stats.sah_cost < s.sah_cost);
 }
 
+#[test]
+fn rotations_lower_the_sah_cost_within_the_depth_cap() {
+    let mut r = rng(21);
+    // Clustered triangles of mixed sizes, where greedy binned splits leave room.
+    let mut tris = random_triangles(&mut r, 3000, 40.0, 0.5);
+    tris.extend(random_triangles(&mut r, 300, 40.0, 12.0));
+    let split_only = super::build::build_with_rotations(&tris, MAX_DEPTH, 0);
+    let rotated = Bvh::build_from_vertices(&tris);
+    check_structure(&split_only, &tris);
+    check_structure(&rotated, &tris);
+    let (before, after) = (&split_only.build_stats, &rotated.build_stats);
+    assert!(
+        after.sah_cost < 0.99 * before.sah_cost,
+        "{before:?} -> {after:?}"
+    );
+    assert_eq!((after.nodes, after.leaves), (before.nodes, before.leaves));
+    for _ in 0..2000 {
+        let o = rand_vec(&mut r, -45.0, 45.0);
+        let d = rand_dir(&mut r);
+        check_ray(&rotated, &tris, o, d, f32::INFINITY);
+        check_ray(&rotated, &tris, o, d * 20.0, 1.0);
+    }
+    // Rotations deepen some subtrees; where that would reach the cap the tree stays as
+    // the splits left it.
+    let cap = before.max_depth;
+    let capped = super::build::build_with_max_depth(&tris, cap);
+    check_structure(&capped, &tris);
+    assert!(
+        capped.build_stats.max_depth <= cap,
+        "{:?}",
+        capped.build_stats
+    );
+}
+
 /// A closed triangulated sphere with shared vertices (UV sphere).
 fn sphere(center: Vec3, radius: f32, rings: usize, segments: usize) -> Vec<[Vec3; 3]> {
     let pole_n = center + Vec3::Y * radius;
