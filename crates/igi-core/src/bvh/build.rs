@@ -410,8 +410,8 @@ const ROTATION_PASSES: usize = 3;
 /// visits the nodes children first and takes the best of a node's four rotations. On the
 /// conference room three passes took the SAH cost from 35.6 to 33.0 (later passes found
 /// little more) and a walk's node visits down 7-8% (CPU counters), for 12-20 ms of the
-/// build on the 2-core machine; on the H200 frames got 2-4% faster, random segments and
-/// closest hits 2-3% slower (docs/PERFORMANCE.md attempt 48).
+/// build on the 2-core machine; on the H200 frames got 2-5% faster, random segments 1-2%
+/// and closest hits 3% slower (docs/PERFORMANCE.md attempt 48).
 fn rotated(built: &[BvhNode], max_depth: u32, passes: usize) -> Option<(Vec<BvhNode>, f64, u32)> {
     if built.len() < 3 || passes == 0 {
         return None;
@@ -562,7 +562,11 @@ fn depth_first(nodes: &[BvhNode]) -> Vec<usize> {
     order
 }
 
-/// The node of two children, the one of larger surface area first (see `build_node`).
+/// The node of two children, the one of larger surface area first: any-hit walks visit
+/// children in the node's order (the same for every ray, which keeps a warp's walks in
+/// step), and the larger box is the one a ray more likely hits (the SAH's own estimate),
+/// so an occluder tends to be found sooner. Frame shadow rays ran 9% faster, random
+/// segments 15% (docs/PERFORMANCE.md, attempt 41). Ties keep the given order.
 fn larger_first(a: BvhChild, b: BvhChild) -> BvhNode {
     if b.half_area() > a.half_area() {
         BvhNode::new(b, a)
@@ -699,17 +703,7 @@ fn build_node(
         let b = build_node(right, out, tally, limits);
         (a, b)
     };
-    // The child of larger surface area goes first: any-hit walks visit children in the
-    // node's order (the same for every ray, which keeps a warp's walks in step), and the
-    // larger box is the one a ray more likely hits (the SAH's own estimate), so an
-    // occluder tends to be found sooner. Frame shadow rays ran 9% faster, random segments
-    // 15% (docs/PERFORMANCE.md, attempt 41). Ties keep the split's order.
-    let (a, b) = if b.half_area() > a.half_area() {
-        (b, a)
-    } else {
-        (a, b)
-    };
-    out[slot] = BvhNode::new(a, b);
+    out[slot] = larger_first(a, b);
     BvhChild {
         min: task.bounds.lo.into(),
         max: task.bounds.hi.into(),
