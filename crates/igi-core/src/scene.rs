@@ -102,7 +102,8 @@ impl Scene {
     }
 
     /// Length of the diagonal of the bounds: the scene's size, used for default
-    /// distances (the bounding distance of G, ray offsets).
+    /// distances (the bounding distance of G) and the depth buffer's unit. Ray offsets
+    /// use [`Scene::ray_offset_floor`] instead.
     pub fn diagonal(&self) -> f32 {
         let (lo, hi) = self.bounds();
         (hi - lo).length()

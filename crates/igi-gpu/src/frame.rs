@@ -171,6 +171,8 @@ impl Renderer {
         let scene_buffers = SceneBuffers::upload(ctx, scene, bvh)?;
         let layout = &scene_buffers.layout;
         let range_layout = gather_range_layout(device);
+        // One pass over the triangles for both figures of the scene's size.
+        let (lo, hi) = scene.bounds();
         let renderer = Renderer {
             vpl: VplPass::new(device, layout),
             direct: DirectPass::new(device, layout, &range_layout),
@@ -205,8 +207,8 @@ impl Renderer {
             camera: scene.camera,
             light_power_sum: light_powers(&scene.lights).0,
             total_power: light_powers(&scene.lights).1,
-            diagonal: scene.diagonal(),
-            ray_offset_floor: scene.ray_offset_floor(),
+            diagonal: (hi - lo).length(),
+            ray_offset_floor: igi_core::bvh::offset_floor(lo, hi),
             path_cache: None,
             counting: false,
             software,

@@ -400,9 +400,9 @@ const ROTATION_PASSES: usize = 3;
 /// The tree improved by Kensler's rotations ("Tree Rotations for Improving Bounding
 /// Volume Hierarchies", 2008), laid out depth first again (child a's subtree right after
 /// its parent), with the sum of its interior half areas below the root and its deepest
-/// leaf's depth; None when there is nothing to rotate, or when the rotations would put
-/// an interior node at `max_depth` (the traversal stack's bound; the tree is then kept
-/// as built).
+/// leaf's depth; None for no passes or a tree of fewer than 3 nodes, or when the
+/// rotations would put an interior node at `max_depth` (the traversal stack's bound; the
+/// tree is then kept as built).
 ///
 /// A rotation at node n swaps one child x with a grandchild g under its other child y,
 /// which becomes (x, the other grandchild): only y's box changes, so it is taken when it
