@@ -17,14 +17,15 @@
 //! stay in depth-first order (left subtree before right, children after their parent)
 //! whatever the thread count: the result does not depend on the machine. In each node the
 //! child of larger surface area is child a, which any-hit walks visit first; it need not
-//! be the left one. Then [`ROTATION_PASSES`] passes of Kensler's tree rotations lower the
-//! SAH cost where the greedy splits left room, and the nodes are laid out depth first
-//! again, child a's subtree right after its parent ([`rotated`]).
+//! be the left one. Each node makes Kensler's tree rotations as soon as its subtree is
+//! built ([`rotate_locally`]), which lowers the SAH cost where the greedy splits left
+//! room; then the nodes are laid out depth first again, child a's subtree right after its
+//! parent.
 
 use std::time::Instant;
 
 use bytemuck::Zeroable;
-use glam::{BVec3A, Vec3, Vec3A};
+use glam::{Vec3, Vec3A};
 
 use super::{
     BuildStats, Bvh, BvhChild, BvhNode, MAX_DEPTH, MAX_LEAF_SIZE, SAH_BINS, SAH_INTERSECT_COST,
@@ -118,6 +119,8 @@ struct Limits {
     max_depth: u32,
     /// Levels whose two subtrees are built on separate threads.
     par_levels: u32,
+    /// Rotations each node may make on the way up ([`rotate_locally`]; 0: none).
+    rotation_budget: u32,
 }
 
 /// The chosen split: bins `< bin` of `axis` go left.
@@ -134,6 +137,7 @@ struct Split {
 const ROUND_MAGIC: f32 = 8_388_608.0;
 const BIN_MASK: u32 = SAH_BINS as u32 - 1;
 const _: () = assert!(SAH_BINS.is_power_of_two() && SAH_BINS >= 4);
+const _: () = assert!(SMALL_RANGE <= 16, "ranks are read back with a 4-bit mask");
 
 /// Maps doubled centroids to bin indices for one node. Binning and partitioning must
 /// agree exactly, so both go through [`Binner::bins`] (the same f32 operations).
@@ -177,7 +181,8 @@ impl Binner {
     #[inline]
     fn bins(&self, c: Vec3A) -> [usize; 3] {
         let x = (c - self.cmin) * self.scale + Vec3A::splat(ROUND_MAGIC);
-        [x.x, x.y, x.z].map(|x| (x.to_bits() & BIN_MASK) as usize)
+        let bits: [u32; 4] = bytemuck::cast(x);
+        [0, 1, 2].map(|axis| (bits[axis] & BIN_MASK) as usize)
     }
 }
 
@@ -186,7 +191,7 @@ pub(super) fn build(triangles: &[Triangle]) -> Bvh {
         triangles.len(),
         |i| triangles[i].v,
         MAX_DEPTH,
-        ROTATION_PASSES,
+        ROTATION_BUDGET,
     )
 }
 
@@ -195,7 +200,7 @@ pub(super) fn build_from_vertices(triangles: &[[Vec3; 3]]) -> Bvh {
         triangles.len(),
         |i| triangles[i],
         MAX_DEPTH,
-        ROTATION_PASSES,
+        ROTATION_BUDGET,
     )
 }
 
@@ -211,14 +216,14 @@ pub(super) fn build_with_max_depth(triangles: &[[Vec3; 3]], max_depth: u32) -> B
         triangles.len(),
         |i| triangles[i],
         max_depth,
-        ROTATION_PASSES,
+        ROTATION_BUDGET,
     )
 }
 
-/// With another number of rotation passes (0: the tree as the splits left it).
+/// With another rotation budget per node (0: the tree as the splits left it).
 #[cfg(test)]
-pub(super) fn build_with_rotations(triangles: &[[Vec3; 3]], max_depth: u32, passes: usize) -> Bvh {
-    build_impl(triangles.len(), |i| triangles[i], max_depth, passes)
+pub(super) fn build_with_rotations(triangles: &[[Vec3; 3]], max_depth: u32, budget: u32) -> Bvh {
+    build_impl(triangles.len(), |i| triangles[i], max_depth, budget)
 }
 
 fn threads() -> usize {
@@ -260,19 +265,15 @@ where
 #[derive(Default)]
 struct Tally {
     leaves: usize,
-    max_depth: u32,
     max_leaf_size: u32,
     oversized_leaves: usize,
-    /// Sum of the half areas of all interior nodes but the root.
-    interior_area: f64,
     /// Sum of half area x triangle count over leaves.
     leaf_area: f64,
 }
 
 impl Tally {
-    fn leaf(&mut self, depth: u32, count: usize, half_area: f32) {
+    fn leaf(&mut self, count: usize, half_area: f32) {
         self.leaves += 1;
-        self.max_depth = self.max_depth.max(depth);
         self.max_leaf_size = self.max_leaf_size.max(count as u32);
         self.oversized_leaves += usize::from(count > MAX_LEAF_SIZE);
         self.leaf_area += (half_area * count as f32) as f64;
@@ -280,15 +281,13 @@ impl Tally {
 
     fn merge(&mut self, o: Tally) {
         self.leaves += o.leaves;
-        self.max_depth = self.max_depth.max(o.max_depth);
         self.max_leaf_size = self.max_leaf_size.max(o.max_leaf_size);
         self.oversized_leaves += o.oversized_leaves;
-        self.interior_area += o.interior_area;
         self.leaf_area += o.leaf_area;
     }
 }
 
-fn build_impl<F>(count: usize, tri: F, max_depth: u32, rotation_passes: usize) -> Bvh
+fn build_impl<F>(count: usize, tri: F, max_depth: u32, rotation_budget: u32) -> Bvh
 where
     F: Fn(usize) -> [Vec3; 3] + Sync,
 {
@@ -303,7 +302,7 @@ where
             nodes: vec![BvhNode::new(BvhChild::EMPTY, BvhChild::EMPTY)],
             tri_verts: vec![],
             tri_order: vec![],
-            build_stats: stats(0, 1, Tally::default(), 0.0, start),
+            build_stats: stats(0, 1, Tally::default(), (0.0, 0), 0.0, start),
         };
     }
 
@@ -340,6 +339,7 @@ where
     let mut ids: Vec<u32> = (0..count as u32).collect();
 
     let mut nodes = Vec::with_capacity(count);
+    let mut heights = Vec::with_capacity(count);
     let mut tally = Tally::default();
     let par_levels = threads().next_power_of_two().trailing_zeros() + 1;
     let root = build_node(
@@ -352,17 +352,20 @@ where
             depth: 0,
         },
         &mut nodes,
+        &mut heights,
         &mut tally,
         &Limits {
             max_depth,
             par_levels,
+            rotation_budget,
         },
-    );
+    )
+    .0;
+    drop(heights);
     if root.count > 0 {
         // A root that is a leaf still needs an interior node 0 to hold its box; the leaf
         // is its child, at depth 1.
         debug_assert!(nodes.is_empty());
-        tally.max_depth = 1;
         nodes.push(BvhNode::new(
             bounds.child(root.index, root.count),
             BvhChild::EMPTY,
@@ -380,12 +383,19 @@ where
         }
     });
 
-    if let Some((rotated, interior_area, max_depth)) = rotated(&nodes, max_depth, rotation_passes) {
-        nodes = rotated;
-        tally.interior_area = interior_area;
-        tally.max_depth = max_depth;
+    if rotation_budget > 0 {
+        // Rotations and larger_first moved subtrees around: child a's subtree right after
+        // its parent again.
+        nodes = depth_first_layout(&nodes);
     }
-    let build_stats = stats(count, nodes.len(), tally, bounds.half_area(), start);
+    let build_stats = stats(
+        count,
+        nodes.len(),
+        tally,
+        interior_area_and_depth(&nodes),
+        bounds.half_area(),
+        start,
+    );
     Bvh {
         nodes,
         tri_verts,
@@ -394,133 +404,101 @@ where
     }
 }
 
-/// Passes of tree rotations after the top-down build (see [`rotated`]).
-const ROTATION_PASSES: usize = 3;
-
-/// The tree improved by Kensler's rotations ("Tree Rotations for Improving Bounding
-/// Volume Hierarchies", 2008), laid out depth first again (child a's subtree right after
-/// its parent), with the sum of its interior half areas below the root and its deepest
-/// leaf's depth; None for no passes or a tree of fewer than 3 nodes, or when the
-/// rotations would put an interior node at `max_depth` (the traversal stack's bound; the
-/// tree is then kept as built).
-///
-/// A rotation at node n swaps one child x with a grandchild g under its other child y,
-/// which becomes (x, the other grandchild): only y's box changes, so it is taken when it
-/// shrinks y's surface area (the SAH cost of the tree falls by the same amount). Each pass
-/// visits the nodes children first and takes the best of a node's four rotations. On the
-/// conference room three passes took the SAH cost from 35.6 to 33.0 (later passes found
-/// little more) and a walk's node visits down 7-8% (CPU counters), for 12-20 ms of the
-/// build on the 2-core machine; on the H200 frames got 2-5% faster, random segments 1-2%
-/// and closest hits 3% slower (docs/PERFORMANCE.md attempt 48).
-fn rotated(built: &[BvhNode], max_depth: u32, passes: usize) -> Option<(Vec<BvhNode>, f64, u32)> {
-    if built.len() < 3 || passes == 0 {
-        return None;
-    }
-    let mut nodes = built.to_vec();
-    for _ in 0..passes {
-        let (rotations, root_rotated) = rotation_pass(&mut nodes);
-        if rotations == 0 {
-            break;
-        }
-        if root_rotated {
-            // The root's subtrees must be contiguous again for the next pass's threads.
-            nodes = depth_first_layout(&nodes);
-        }
-    }
-    let nodes = depth_first_layout(&nodes);
-    // Depths, the interior area and the cap, in one walk in index order (children come
-    // after their parent).
-    let mut depth = vec![0u32; nodes.len()];
-    let (mut interior_area, mut deepest) = (0.0f64, 0u32);
-    for (k, n) in nodes.iter().enumerate() {
-        for c in [n.a(), n.b()] {
-            if c.count > 0 {
-                deepest = deepest.max(depth[k] + 1);
-            } else if is_node(&c) {
-                depth[c.index as usize] = depth[k] + 1;
-                if depth[k] + 1 >= max_depth {
-                    return None;
-                }
-                interior_area += c.half_area() as f64;
-            }
-        }
-    }
-    Some((nodes, interior_area, deepest))
-}
+/// Rotations a node may make on the way up of the build (see [`rotate_locally`]).
+const ROTATION_BUDGET: u32 = 8;
 
 /// Whether a child is an interior node (not a leaf, not the empty child of a root leaf).
 fn is_node(c: &BvhChild) -> bool {
     c.count == 0 && c.min.x <= c.max.x
 }
 
-/// One pass of rotations, from the last node to the first (children before parents in a
-/// depth-first layout, where the root's two subtrees are contiguous index ranges: they
-/// go to two threads), the root last. Returns the rotations made and whether the root
-/// rotated (which mixes the two ranges).
-fn rotation_pass(nodes: &mut [BvhNode]) -> (usize, bool) {
-    let root = nodes[0];
-    let (a, b) = (root.a(), root.b());
-    let rotations = if is_node(&a) && is_node(&b) && threads() > 1 && nodes.len() >= 1024 {
-        // One child's subtree is [1, split), the other's [split, len).
-        let split = a.index.max(b.index) as usize;
-        let (first, second) = nodes.split_at_mut(split);
-        std::thread::scope(|s| {
-            let second_pass = s.spawn(|| rotate_range(second, split));
-            let first = rotate_range(&mut first[1..], 1);
-            first + second_pass.join().expect("BVH rotation thread panicked")
-        })
+/// Levels below a child: 0 for a leaf, its node's height for an interior node.
+fn height(c: &BvhChild, heights: &[u8]) -> u8 {
+    if is_node(c) {
+        heights[c.index as usize]
     } else {
-        rotate_range(&mut nodes[1..], 1)
-    };
-    let root_rotated = rotate_node(nodes, 0, 0);
-    (rotations + usize::from(root_rotated), root_rotated)
+        0
+    }
 }
 
-/// Rotations at every node of `nodes`, whose first entry is node `offset` of the tree, in
-/// reverse index order (children before parents); all children of these nodes lie in
-/// the slice (a subtree of a depth-first layout).
-fn rotate_range(nodes: &mut [BvhNode], offset: usize) -> usize {
-    (offset..offset + nodes.len())
-        .rev()
-        .filter(|&i| rotate_node(nodes, offset, i))
-        .count()
+/// Kensler's tree rotations ("Tree Rotations for Improving Bounding Volume Hierarchies",
+/// 2008) at node `i` of a subtree just built, after each rotation at the child that
+/// changed too (its new children may rotate in turn), at most `budget` rotations in all.
+/// `depth` is node i's; `heights` holds the levels below each node (1 for a node whose
+/// children are leaves).
+///
+/// A rotation swaps one child x with a grandchild g under its other child y, which
+/// becomes (x, the other grandchild): only y's box changes, so it is taken when it
+/// shrinks y's surface area (the SAH cost of the tree falls by the same amount), the
+/// best of the node's four, and only if it keeps every interior node above `max_depth`
+/// (the traversal stack's bound). Made as each node's subtree is finished, while it is in
+/// cache, this is one bottom-up pass over the tree in which every node settles before its
+/// parent looks at it. On the conference room: SAH cost 35.6 -> 33.0, the same as three
+/// separate passes over the finished tree, which cost 12-20 ms more of the 2-core
+/// machine's build (docs/PERFORMANCE.md attempts 48 and 49).
+fn rotate_locally(
+    nodes: &mut [BvhNode],
+    heights: &mut [u8],
+    i: usize,
+    depth: u32,
+    max_depth: u32,
+    budget: &mut u32,
+) {
+    while *budget > 0 {
+        let Some(y) = rotate_node(nodes, heights, i, depth, max_depth) else {
+            return;
+        };
+        *budget -= 1;
+        rotate_locally(nodes, heights, y, depth + 1, max_depth, budget);
+        let n = nodes[i];
+        heights[i] = 1 + height(&n.a(), heights).max(height(&n.b(), heights));
+    }
 }
 
-/// The best of node i's four rotations, if one shrinks a box (see [`rotated`]); `nodes`
-/// starts at node `offset`.
-fn rotate_node(nodes: &mut [BvhNode], offset: usize, i: usize) -> bool {
-    let kids = {
-        let n = &nodes[i - offset];
-        [n.a(), n.b()]
-    };
-    // (area saved, the side of x, the grandchild that moves up)
-    let mut best: Option<(f32, usize, usize)> = None;
+/// The best rotation at node `i` (see [`rotate_locally`]), if one shrinks a box within
+/// the depth cap; returns the index of the child whose children changed.
+fn rotate_node(
+    nodes: &mut [BvhNode],
+    heights: &mut [u8],
+    i: usize,
+    depth: u32,
+    max_depth: u32,
+) -> Option<usize> {
+    let kids = [nodes[i].a(), nodes[i].b()];
+    let h = |c: &BvhChild| height(c, heights);
+    // (area saved, the side of x, the grandchild that moves up, the new heights of y and i)
+    let mut best: Option<(f32, usize, usize, u8, u8)> = None;
     for side in 0..2 {
         let (x, y) = (kids[side], kids[1 - side]);
         if !is_node(&y) {
             continue;
         }
-        let grand = &nodes[y.index as usize - offset];
+        let grand = &nodes[y.index as usize];
         let g = [grand.a(), grand.b()];
         for k in 0..2 {
             let saved = y.half_area() - union(&x, &g[1 - k]).half_area();
+            let y_height = 1 + h(&x).max(h(&g[1 - k]));
+            let i_height = 1 + h(&g[k]).max(y_height);
             // A relative threshold, so that rounding cannot make rotations cycle.
-            if saved > 1e-6 * y.half_area() && best.is_none_or(|b| saved > b.0) {
-                best = Some((saved, side, k));
+            if saved > 1e-6 * y.half_area()
+                && depth + i_height as u32 <= max_depth
+                && best.is_none_or(|b| saved > b.0)
+            {
+                best = Some((saved, side, k, y_height, i_height));
             }
         }
     }
-    let Some((_, side, k)) = best else {
-        return false;
-    };
+    let (_, side, k, y_height, i_height) = best?;
     let (x, y) = (kids[side], kids[1 - side]);
-    let grand = nodes[y.index as usize - offset];
+    let grand = nodes[y.index as usize];
     let g = [grand.a(), grand.b()];
     let (up, stays) = (g[k], g[1 - k]);
-    nodes[y.index as usize - offset] = larger_first(x, stays);
+    nodes[y.index as usize] = larger_first(x, stays);
+    heights[y.index as usize] = y_height;
     let y = union(&x, &stays).child(y.index, 0);
-    nodes[i - offset] = larger_first(up, y);
-    true
+    nodes[i] = larger_first(up, y);
+    heights[i] = i_height;
+    Some(y.index as usize)
 }
 
 /// The tree renumbered depth first, child a's subtree right after its parent (any-hit
@@ -562,6 +540,24 @@ fn depth_first(nodes: &[BvhNode]) -> Vec<usize> {
     order
 }
 
+/// The sum of the interior nodes' half areas below the root and the deepest leaf's depth
+/// (the root has depth 0), in one walk in index order (children come after their parent).
+fn interior_area_and_depth(nodes: &[BvhNode]) -> (f64, u32) {
+    let mut depth = vec![0u32; nodes.len()];
+    let (mut interior_area, mut deepest) = (0.0f64, 0u32);
+    for (k, n) in nodes.iter().enumerate() {
+        for c in [n.a(), n.b()] {
+            if is_node(&c) {
+                depth[c.index as usize] = depth[k] + 1;
+                interior_area += c.half_area() as f64;
+            } else if c.min.x <= c.max.x {
+                deepest = deepest.max(depth[k] + 1);
+            }
+        }
+    }
+    (interior_area, deepest)
+}
+
 /// The node of two children, the one of larger surface area first: any-hit walks visit
 /// children in the node's order (the same for every ray, which keeps a warp's walks in
 /// step), and the larger box is the one a ray more likely hits (the SAH's own estimate),
@@ -595,20 +591,23 @@ fn range_bounds(prims: &[PrimRef]) -> (Aabb, Aabb) {
     (b, c)
 }
 
-/// Builds the subtree of `task`; pushes its interior nodes to `out` (depth first, this
-/// node first) and returns the reference to it as a child: an interior node (count 0,
-/// index into `out`) or a leaf (count > 0, index = first BVH slot).
+/// Builds the subtree of `task`; pushes its interior nodes to `out` (this node first)
+/// and their heights to `heights` (see [`rotate_locally`]), and returns the reference to
+/// it as a child (an interior node: count 0, index into `out`; or a leaf: count > 0,
+/// index = first BVH slot) with its height (0 for a leaf). Each node makes its rotations
+/// as soon as its subtree is built.
 fn build_node(
     task: Task<'_>,
     out: &mut Vec<BvhNode>,
+    heights: &mut Vec<u8>,
     tally: &mut Tally,
     limits: &Limits,
-) -> BvhChild {
+) -> (BvhChild, u8) {
     let n = task.prims.len();
     let area = task.bounds.half_area();
     let leaf = |tally: &mut Tally| {
-        tally.leaf(task.depth, n, area);
-        task.bounds.child(task.first, n as u32)
+        tally.leaf(n, area);
+        (task.bounds.child(task.first, n as u32), 0)
     };
     if n == 1 || task.depth >= limits.max_depth {
         return leaf(tally);
@@ -648,11 +647,9 @@ fn build_node(
         }
     };
 
-    if task.depth > 0 {
-        tally.interior_area += area as f64;
-    }
     let slot = out.len();
     out.push(BvhNode::zeroed());
+    heights.push(0);
     let depth = task.depth + 1;
     let (lp, rp) = task.prims.split_at_mut(k);
     let (li, ri) = task.ids.split_at_mut(k);
@@ -673,15 +670,25 @@ fn build_node(
         depth,
     };
 
-    let (a, b) = if task.depth < limits.par_levels && n >= PARALLEL_MIN_PRIMS {
+    let ((a, ha), (b, hb)) = if task.depth < limits.par_levels && n >= PARALLEL_MIN_PRIMS {
         let mut right_nodes = Vec::with_capacity(n - k);
+        let mut right_heights = Vec::with_capacity(n - k);
         let mut right_tally = Tally::default();
         let (a, b) = std::thread::scope(|s| {
-            let handle = s.spawn(|| build_node(right, &mut right_nodes, &mut right_tally, limits));
-            let a = build_node(left, out, tally, limits);
+            let handle = s.spawn(|| {
+                build_node(
+                    right,
+                    &mut right_nodes,
+                    &mut right_heights,
+                    &mut right_tally,
+                    limits,
+                )
+            });
+            let a = build_node(left, out, heights, tally, limits);
             (a, handle.join().expect("BVH build thread panicked"))
         });
         tally.merge(right_tally);
+        heights.extend(right_heights);
         // The right subtree numbered its nodes from 0: move them behind the left one.
         let offset = out.len() as u32;
         out.extend(right_nodes.into_iter().map(|mut node| {
@@ -694,22 +701,27 @@ fn build_node(
             node
         }));
         let mut b = b;
-        if b.count == 0 {
-            b.index += offset;
+        if b.0.count == 0 {
+            b.0.index += offset;
         }
         (a, b)
     } else {
-        let a = build_node(left, out, tally, limits);
-        let b = build_node(right, out, tally, limits);
+        let a = build_node(left, out, heights, tally, limits);
+        let b = build_node(right, out, heights, tally, limits);
         (a, b)
     };
     out[slot] = larger_first(a, b);
-    BvhChild {
-        min: task.bounds.lo.into(),
-        max: task.bounds.hi.into(),
-        index: slot as u32,
-        count: 0,
-    }
+    heights[slot] = 1 + ha.max(hb);
+    let mut budget = limits.rotation_budget;
+    rotate_locally(
+        out,
+        heights,
+        slot,
+        task.depth,
+        limits.max_depth,
+        &mut budget,
+    );
+    (task.bounds.child(slot as u32, 0), heights[slot])
 }
 
 /// Exact SAH sweep of a small range (2..=SMALL_RANGE primitives): for each axis the
@@ -749,19 +761,21 @@ impl SmallSweep {
             *ci = p.centroid2();
         }
         // Rank of each primitive along each axis (ties by index, so equal centroids are
-        // split by index): branch-free, all three axes at once.
-        let mut rank = [Vec3A::ZERO; SMALL_RANGE];
+        // split by index): branch-free, all three axes at once. Those before i in index
+        // order count when not greater, those after when less.
         for i in 0..n {
             let mut r = Vec3A::ZERO;
-            for (j, cj) in c[..n].iter().enumerate() {
-                let before = cj.cmplt(c[i]) | (cj.cmpeq(c[i]) & BVec3A::splat(j < i));
-                r += Vec3A::select(before, Vec3A::ONE, Vec3A::ZERO);
+            for cj in &c[..i] {
+                r += Vec3A::select(cj.cmple(c[i]), Vec3A::ONE, Vec3A::ZERO);
             }
-            rank[i] = r;
-        }
-        for (i, r) in rank[..n].iter().enumerate() {
-            for axis in 0..3 {
-                sweep.order[axis][r[axis] as usize] = i as u8;
+            for cj in &c[i + 1..n] {
+                r += Vec3A::select(cj.cmplt(c[i]), Vec3A::ONE, Vec3A::ZERO);
+            }
+            // The ranks (< 16) as integers by ROUND_MAGIC, not a saturating cast; the lanes
+            // through an array, not glam's Vec3A indexing (which goes through memory).
+            let ranks: [u32; 4] = bytemuck::cast(r + Vec3A::splat(ROUND_MAGIC));
+            for (order, r) in sweep.order.iter_mut().zip(ranks) {
+                order[(r & 15) as usize] = i as u8;
             }
         }
         for axis in 0..3 {
@@ -967,9 +981,16 @@ fn partition_on<const AXIS: usize>(
     }
 }
 
-fn stats(triangles: usize, nodes: usize, t: Tally, root_area: f32, start: Instant) -> BuildStats {
+fn stats(
+    triangles: usize,
+    nodes: usize,
+    t: Tally,
+    (interior_area, max_depth): (f64, u32),
+    root_area: f32,
+    start: Instant,
+) -> BuildStats {
     let cost = if root_area > 0.0 {
-        (SAH_TRAVERSAL_COST as f64 * t.interior_area + SAH_INTERSECT_COST as f64 * t.leaf_area)
+        (SAH_TRAVERSAL_COST as f64 * interior_area + SAH_INTERSECT_COST as f64 * t.leaf_area)
             / root_area as f64
     } else {
         0.0
@@ -979,7 +1000,7 @@ fn stats(triangles: usize, nodes: usize, t: Tally, root_area: f32, start: Instan
         triangles,
         nodes,
         leaves: t.leaves,
-        max_depth: t.max_depth,
+        max_depth,
         max_leaf_size: t.max_leaf_size,
         oversized_leaves: t.oversized_leaves,
         sah_cost: (SAH_TRAVERSAL_COST as f64 + cost) as f32,
@@ -998,6 +1019,7 @@ pub(super) fn stats_by_walk(bvh: &Bvh) -> BuildStats {
         count: 0,
     });
     let mut t = Tally::default();
+    let (mut interior_area, mut max_depth) = (0.0f64, 0u32);
     // Children come after their parent (depth-first order): one pass in index order sees
     // every node's depth before its children's.
     let mut depth = vec![0u32; bvh.nodes.len()];
@@ -1007,11 +1029,12 @@ pub(super) fn stats_by_walk(bvh: &Bvh) -> BuildStats {
                 if c.min.x > c.max.x {
                     continue; // the empty child
                 }
-                t.leaf(depth[i] + 1, c.count as usize, area(&c));
+                t.leaf(c.count as usize, area(&c));
+                max_depth = max_depth.max(depth[i] + 1);
             } else {
                 assert!(c.index as usize > i, "child {} before parent {i}", c.index);
                 depth[c.index as usize] = depth[i] + 1;
-                t.interior_area += area(&c) as f64;
+                interior_area += area(&c) as f64;
             }
         }
     }
@@ -1019,6 +1042,7 @@ pub(super) fn stats_by_walk(bvh: &Bvh) -> BuildStats {
         bvh.tri_order.len(),
         bvh.nodes.len(),
         t,
+        (interior_area, max_depth),
         root_area,
         Instant::now(),
     );

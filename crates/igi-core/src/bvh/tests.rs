@@ -345,16 +345,23 @@ fn rotations_lower_the_sah_cost_within_the_depth_cap() {
         check_ray(&rotated, &tris, o, d, f32::INFINITY);
         check_ray(&rotated, &tris, o, d * 20.0, 1.0);
     }
-    // Rotations deepen some subtrees; where that would reach the cap the tree stays as
-    // the splits left it.
+    // Rotations deepen some subtrees; none may take an interior node to the cap, but the
+    // others still pay.
     let cap = before.max_depth;
+    assert!(
+        after.max_depth > cap,
+        "the test needs rotations that deepen the tree"
+    );
     let capped = super::build::build_with_max_depth(&tris, cap);
     check_structure(&capped, &tris);
-    assert!(
-        capped.build_stats.max_depth <= cap,
-        "{:?}",
-        capped.build_stats
-    );
+    let c = &capped.build_stats;
+    assert!(c.max_depth <= cap, "{c:?}");
+    assert!(c.sah_cost < 0.99 * before.sah_cost, "{before:?} -> {c:?}");
+    for _ in 0..500 {
+        let o = rand_vec(&mut r, -45.0, 45.0);
+        let d = rand_dir(&mut r);
+        check_ray(&capped, &tris, o, d, f32::INFINITY);
+    }
 }
 
 /// A closed triangulated sphere with shared vertices (UV sphere).
