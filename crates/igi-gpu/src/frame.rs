@@ -76,6 +76,11 @@ struct ImageBuffers {
     /// of the mirror indirect stage's dispatch.
     mirror_list: wgpu::Buffer,
     mirror_args: wgpu::Buffer,
+    /// The pixels whose mirror chain the direct pass's later walks follow (direct.wgsl's
+    /// chain_list: two counters, then the pixels), and the workgroup counts of that
+    /// dispatch.
+    chain_list: wgpu::Buffer,
+    chain_args: wgpu::Buffer,
     /// E at the indirect resolution, as the indirect pass leaves it.
     irradiance: wgpu::Buffer,
     /// After the discontinuity buffer (indirect resolution).
@@ -308,6 +313,8 @@ impl Renderer {
                 &b.color,
                 &b.mirror_list,
                 &b.mirror_args,
+                &b.chain_list,
+                &b.chain_args,
             ]
             .iter()
             .map(|b| b.size())
@@ -353,10 +360,19 @@ impl Renderer {
         let list_size = (2 * MAX_SUBSETS as u64
             + (width as u64 + MAX_SUBSETS as u64 - 1) * (height as u64 + MAX_SUBSETS as u64 - 1))
             * 4;
+        let chain_size = (2 + width as u64 * height as u64) * 4;
         let device = &ctx.device;
+        let dispatch_args = |label| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: 16,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT,
+                mapped_at_creation: false,
+            })
+        };
         let images = ctx.allocate(
             || format!("the {IMAGE_BUFFERS} frame buffers of a {width}x{height} image"),
-            IMAGE_BUFFERS as u64 * size.max(16) + list_size,
+            IMAGE_BUFFERS as u64 * size.max(16) + list_size + chain_size,
             SMALLER_FRAME,
             || ImageBuffers {
                 width,
@@ -379,12 +395,9 @@ impl Renderer {
                 filtered: storage(device, "irradiance full resolution", size),
                 color: storage(device, "color", size),
                 mirror_list: storage(device, "mirror list", list_size),
-                mirror_args: device.create_buffer(&wgpu::BufferDescriptor {
-                    label: Some("mirror indirect dispatch"),
-                    size: 16,
-                    usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT,
-                    mapped_at_creation: false,
-                }),
+                mirror_args: dispatch_args("mirror indirect dispatch"),
+                chain_list: storage(device, "mirror chain list", chain_size),
+                chain_args: dispatch_args("mirror chains dispatch"),
             },
         )?;
         self.images = Some(images);
@@ -862,6 +875,7 @@ impl Renderer {
                         &img.mirror[3],
                     ],
                     mirror_list: &img.mirror_list,
+                    chain_list: &img.chain_list,
                 },
             )
         };
@@ -929,6 +943,8 @@ impl Renderer {
             count: 1,
         };
         let args_step = [self.indirect.args_step()];
+        let chain_args_step = [self.direct.args_step()];
+        let chain_args_bind = self.direct.bind_args(device, &img.chain_args);
         let compact_step = [compact];
         let mut list_parts = vec![Dispatches {
             steps: &compact_step,
@@ -948,21 +964,35 @@ impl Renderer {
                 group3: Some(args_bind),
                 indirect: None,
             });
+            // Sizes the later walks of the direct pass from its list of chains (and
+            // resets the list, which the first walk fills in any scene with mirrors).
+            list_parts.push(Dispatches {
+                steps: &chain_args_step,
+                scene,
+                pass: &direct_first,
+                ranges: Some(&one_range),
+                group3: Some(&chain_args_bind),
+                indirect: None,
+            });
         }
         let i = stage("vpl list");
         rec.stage(i, "vpl list", &list_parts);
 
         // Hits seen in a mirror seen in a mirror gather their VPLs in later walks of the
-        // direct pass, over the chains its first walk flagged.
+        // direct pass, over the chains its first walk listed.
         if self.has_mirrors && settings.mirror_depth >= 2 {
             let i = stage("mirror chains");
-            rec.dispatch(
+            rec.stage(
                 i,
                 "mirror chains",
-                &self.direct.steps(full.0, full.1, iv),
-                scene,
-                &direct_bind(&vb.vpls, &self.vpl_header),
-                Some(&ranges),
+                &[Dispatches {
+                    steps: &[(self.direct.chains_pipeline(iv), [0, 0, 0])],
+                    scene,
+                    pass: &direct_bind(&vb.vpls, &self.vpl_header),
+                    ranges: Some(&ranges),
+                    group3: None,
+                    indirect: Some(&img.chain_args),
+                }],
             );
         }
 

@@ -5,12 +5,13 @@
 // pass reaches them): at the first such hit it is gathered by indirect.wgsl from the
 // record written here (compose adds it), at any later one (a mirror seen in a mirror)
 // here. Writes the G-buffer of the primary hit.
-// The pass walks twice. Its first walk gathers no VPLs, so that it can run beside VPL
-// shooting, before any VPL exists (frame.rs: the two are not kept apart by a barrier); it
-// does everything else and flags the pixels whose chain has hits seen in a mirror seen in
-// a mirror (albedo w = 2). Later walks, after VPL shooting, follow only those chains again
-// and add the VPL light of their range (one range on GPUs, several on llvmpipe, see
-// gather.wgsl) at those hits.
+// The pass walks twice. Its first walk (`main`) gathers no VPLs, so that it can run
+// beside VPL shooting, before any VPL exists (frame.rs: the two are not kept apart by a
+// barrier); it does everything else and lists the pixels whose chain has hits seen in a
+// mirror seen in a mirror (and flags them: albedo w = 2). Later walks (`chains_main`,
+// after VPL shooting, dispatched over that list) follow only those chains again and add
+// the VPL light of their range (one range on GPUs, several on llvmpipe, see gather.wgsl)
+// at those hits.
 
 @group(1) @binding(1) var<storage, read> vpls: array<Vpl>;
 @group(1) @binding(2) var<storage, read> vpl_header: VplHeader;
@@ -34,17 +35,59 @@
 // read them), [MAX_SUBSETS + s] is that stage's copy of the count, bucket s starts at
 // 2 MAX_SUBSETS + s mirror_bucket_size().
 @group(1) @binding(12) var<storage, read_write> mirror_list: array<atomic<u32>>;
+// The pixels whose chain has hits seen in a mirror seen in a mirror, for the later walks:
+// [0] counts those the first walk appended (reset by chain_args_main once it has read
+// it), [1] is the later walks' copy of the count, the pixels follow from [2] on. (A
+// dispatch over the whole image that skipped the others took 0.018 ms of the H200 in the
+// conference room, which has none: docs/PERFORMANCE.md attempt 50.)
+@group(1) @binding(13) var<storage, read_write> chain_list: array<atomic<u32>>;
 
-// One thread per pixel, 8 x 4 pixels (one warp) per workgroup: 8 x 8 took 0.74 ms against
-// 0.66 ms on the H200 (conference room, 800 x 600; docs/PERFORMANCE.md attempt 32).
+// The first walk: one thread per pixel, 8 x 4 pixels (one warp) per workgroup: 8 x 8 took
+// 0.74 ms against 0.66 ms on the H200 (conference room, 800 x 600; docs/PERFORMANCE.md
+// attempt 32).
 @compute @workgroup_size(8, 4)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (gid.x >= params.width || gid.y >= params.height) {
         return;
     }
-    let pixel = gid.y * params.width + gid.x;
+    shade(gid.x, gid.y);
+}
+
+// Workgroup counts of chains_main, for dispatch_workgroups_indirect.
+@group(3) @binding(0) var<storage, read_write> chain_args: array<u32>;
+
+// One thread: takes this frame's count of listed chains, resets the counter for the next
+// frame and sizes chains_main's dispatch.
+@compute @workgroup_size(1)
+fn chain_args_main() {
+    let n = atomicLoad(&chain_list[0]);
+    atomicStore(&chain_list[0], 0u);
+    atomicStore(&chain_list[1], n);
+    let size = dispatch_size((n + CHAIN_GROUP - 1u) / CHAIN_GROUP, 1u);
+    chain_args[0] = size.x;
+    chain_args[1] = size.y;
+    chain_args[2] = size.z;
+}
+
+// Listed pixels per workgroup of chains_main.
+const CHAIN_GROUP: u32 = 32u;
+
+// A later walk over the listed pixels, one thread each.
+@compute @workgroup_size(CHAIN_GROUP)
+fn chains_main(@builtin(workgroup_id) group: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>, @builtin(local_invocation_index) l: u32) {
+    let slot = (group.x + group.y * groups.x) * CHAIN_GROUP + l;
+    if (slot >= atomicLoad(&chain_list[1])) {
+        return;
+    }
+    let pixel = atomicLoad(&chain_list[2u + slot]);
+    shade(pixel % params.width, pixel / params.width);
+}
+
+// Pixel (x, y)'s chain, in the walk `gather_range` says.
+fn shade(x: u32, y: u32) {
+    let pixel = y * params.width + x;
     var origin = params.cam_eye;
-    var dir = camera_ray_dir(gid.x, gid.y);
+    var dir = camera_ray_dir(x, y);
     var throughput = vec3<f32>(1.0);
     var radiance = vec3<f32>(0.0);
     let first_walk = gather_range.first_walk != 0u;
@@ -93,7 +136,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             if (depth > 0u && !recorded) {
                 recorded = true;
                 if (first_walk) {
-                    let bucket = interleave_subset(gid.x, gid.y);
+                    let bucket = interleave_subset(x, y);
                     let slot = atomicAdd(&mirror_list[bucket], 1u);
                     atomicStore(&mirror_list[2u * MAX_SUBSETS + bucket * mirror_bucket_size() + slot], pixel);
                     mirror_position[pixel] = vec4<f32>(s.position, 1.0);
@@ -125,6 +168,8 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         count_rays(RAY_MIRROR, traced - 1u);
         if (chained) {
             gbuf_albedo[pixel].w = 2.0;
+            let slot = atomicAdd(&chain_list[0], 1u);
+            atomicStore(&chain_list[2u + slot], pixel);
         }
     }
     direct_out[pixel] = vec4<f32>(radiance, 1.0);

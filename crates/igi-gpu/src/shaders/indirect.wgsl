@@ -95,9 +95,6 @@ fn main_coherent(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocat
 // Workgroups of main_list (x, y, z), for dispatch_workgroups_indirect.
 @group(3) @binding(1) var<storage, read_write> mirror_args: array<u32>;
 
-// Largest workgroup count of one dispatch dimension.
-const MAX_GROUPS: u32 = 65535u;
-
 // Threads of a main_list workgroup, and the listed pixels it takes (each with VPL_LANES
 // lanes).
 const LIST_GROUP: u32 = 256u;
@@ -116,11 +113,10 @@ fn mirror_args_main() {
         most = max(most, n);
     }
     let per_group = LIST_GROUP / VPL_LANES;
-    let groups = (most + per_group - 1u) / per_group;
-    let x = min(groups, MAX_GROUPS);
-    mirror_args[0] = x;
-    mirror_args[1] = select(0u, (groups + x - 1u) / max(x, 1u), x > 0u);
-    mirror_args[2] = select(0u, subsets, x > 0u);
+    let size = dispatch_size((most + per_group - 1u) / per_group, subsets);
+    mirror_args[0] = size.x;
+    mirror_args[1] = size.y;
+    mirror_args[2] = size.z;
 }
 
 // The gather over the listed pixels of bucket group.z, VPL_LANES threads per pixel, a
