@@ -1060,7 +1060,11 @@ impl Renderer {
                 low.0,
                 low.1,
                 iv,
-                lanes_for(low.0 * low.1, self.software),
+                lanes_for(
+                    low.0 * low.1,
+                    a.interleave.0 * a.interleave.1 > 1,
+                    self.software,
+                ),
                 a.interleave,
             ),
             scene,

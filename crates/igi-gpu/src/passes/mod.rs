@@ -97,20 +97,22 @@ impl GatherPipelines {
 
 /// VPL lanes per pixel the indirect pass is built for: `main` (one) and `main_coherent`
 /// (more: a warp holds one lane of 32 pixels of one interleaving subset).
-pub const LANE_CHOICES: [u32; 3] = [1, 4, 8];
+pub const LANE_CHOICES: [u32; 4] = [1, 4, 8, 16];
 
 /// Lanes per pixel of the indirect pass at the mirrored hits (the mirror indirect stage,
 /// over the list of those pixels): few pixels see a mirror (18000 of 480000 in the
 /// conference room), so their VPL loops are split over 8 threads; one lane on a software
 /// adapter. 8 beat 32 and 1 on the H200 at 800 x 600 and 1920 x 1080, canonical and
-/// interleaved (docs/PERFORMANCE.md, attempts 17 and 26). `IGI_MIRROR_LANES` (1, 2, 4, 8
-/// or 32) overrides it, for measurements.
+/// interleaved (docs/PERFORMANCE.md, attempts 17 and 26). 16 took the stage from 0.92 to
+/// 0.83 ms in canonical frames at 800 x 600, but made it 25-40% slower in interleaved ones
+/// and no faster at 1920 x 1080 (attempt 51). `IGI_MIRROR_LANES` (1, 2,
+/// 4, 8, 16 or 32) overrides it, for measurements.
 pub fn mirror_lanes(software: bool) -> u32 {
     if let Some(l) = std::env::var("IGI_MIRROR_LANES")
         .ok()
         .and_then(|v| v.parse::<u32>().ok())
     {
-        if [1, 2, 4, 8, 32].contains(&l) {
+        if [1, 2, 4, 8, 16, 32].contains(&l) {
             return l;
         }
     }
@@ -139,13 +141,30 @@ pub fn mirror_lanes(software: bool) -> u32 {
 /// sizes measured where 4 and 8 lanes trade places, so that the worse choice there costs
 /// least (0.04 ms at iv+ds+il 1080p). One lane per pixel (`main`, 8 x 8 pixels a
 /// workgroup, not grouped by subset) loses everywhere on a GPU, and 2 lanes never win,
-/// so the pass is not built for them. `IGI_VPL_LANES` (1, 4 or 8) overrides the choice,
-/// for measurements.
+/// so the pass is not built for them. Small images that are not interleaved take 16
+/// lanes (see [`LANES_16_MAX_PIXELS`]). `IGI_VPL_LANES` (1, 4, 8 or 16) overrides the
+/// choice, for measurements.
 pub const LANES_BELOW_PIXELS: u32 = 200_000;
 
-/// The lanes a gathering pass uses over `pixels` pixels; always one on a software
-/// adapter, which has few threads to fill and whose workgroup barriers are slow.
-pub fn lanes_for(pixels: u32, software: bool) -> u32 {
+/// Up to this many pixels of an indirect term that is not interleaved (every pixel
+/// gathers every VPL), each pixel's VPLs are split over 16 lanes. Indirect stage in ms on
+/// the H200, conference room, imperfect visibility and downsampling by 4, for 8 / 16
+/// lanes (docs/PERFORMANCE.md attempt 51):
+///
+/// | indirect term | pixels | 30 VPLs | 90 VPLs | 180 VPLs |
+/// |---|---|---|---|---|
+/// | 800 x 600 | 30,000 | 0.294 / **0.245** | 0.628 / **0.562** | 1.305 / **1.143** |
+/// | 1280 x 720 | 57,600 | **0.382** / 0.389 | 0.922 / **0.886** | 1.910 / **1.692** |
+/// | 1920 x 1080 | 129,600 | | | **3.04** / 3.33 |
+///
+/// Interleaved terms gather a ninth as many VPLs per pixel (3 x 3 subsets) and lose with
+/// 16 lanes: 0.267 / 0.322 ms at 800 x 600, 0.616 / 0.887 at 1920 x 1080.
+pub const LANES_16_MAX_PIXELS: u32 = 65_536;
+
+/// The lanes a gathering pass uses over `pixels` pixels, `interleaved` or not; always one
+/// on a software adapter, which has few threads to fill and whose workgroup barriers are
+/// slow.
+pub fn lanes_for(pixels: u32, interleaved: bool, software: bool) -> u32 {
     if let Some(l) = std::env::var("IGI_VPL_LANES")
         .ok()
         .and_then(|v| v.parse::<u32>().ok())
@@ -156,6 +175,8 @@ pub fn lanes_for(pixels: u32, software: bool) -> u32 {
     }
     if software {
         1
+    } else if !interleaved && pixels <= LANES_16_MAX_PIXELS {
+        16
     } else if pixels < LANES_BELOW_PIXELS {
         8
     } else {

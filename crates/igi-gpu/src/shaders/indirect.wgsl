@@ -54,7 +54,9 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
 // coherence, not correctness: attempt 30), and group.z is that place in the tile. The
 // lanes' sums are added in lane order.
 override COHERENT_LANES: u32 = 8u;
-var<workgroup> coherent_sums: array<vec4<f32>, 256>;
+// One sum per thread of the workgroup (main_coherent's 32 COHERENT_LANES, main_list's
+// LIST_GROUP).
+var<workgroup> coherent_sums: array<vec4<f32>, max(32u * COHERENT_LANES, LIST_GROUP)>;
 
 // The sum of pixel p's `lanes` lane sums in lane order (lane k of the workgroup's
 // `pixels` pixels stored its sum at k pixels + p), after a workgroup barrier.
@@ -95,9 +97,9 @@ fn main_coherent(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocat
 // Workgroups of main_list (x, y, z), for dispatch_workgroups_indirect.
 @group(3) @binding(1) var<storage, read_write> mirror_args: array<u32>;
 
-// Threads of a main_list workgroup, and the listed pixels it takes (each with VPL_LANES
-// lanes).
-const LIST_GROUP: u32 = 256u;
+// Threads of a main_list workgroup: 256, or 32 per lane where that is more, so that a
+// warp always holds one lane of 32 pixels; it takes LIST_GROUP / VPL_LANES listed pixels.
+override LIST_GROUP: u32 = max(256u, 32u * VPL_LANES);
 
 // One thread: takes this frame's counts of mirrored pixels, resets the counters for the
 // next frame and sizes main_list's dispatch: one z layer per subset, as many workgroups
@@ -122,7 +124,7 @@ fn mirror_args_main() {
 // The gather over the listed pixels of bucket group.z, VPL_LANES threads per pixel, a
 // warp holding one lane of 32 pixels (as main_coherent): they trace to the same VPL at
 // each step. The lanes' sums are added in lane order.
-@compute @workgroup_size(256)
+@compute @workgroup_size(LIST_GROUP)
 fn main_list(@builtin(workgroup_id) group: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>, @builtin(local_invocation_index) l: u32) {
     let per_group = LIST_GROUP / VPL_LANES;
     let p = l % per_group;
