@@ -85,7 +85,7 @@ struct ImageBuffers {
     irradiance: wgpu::Buffer,
     /// After the discontinuity buffer (indirect resolution).
     filtered_low: wgpu::Buffer,
-    /// After upsampling or the fused filter (full resolution).
+    /// After the fused filter (full resolution).
     filtered: wgpu::Buffer,
     color: wgpu::Buffer,
 }
@@ -1073,14 +1073,12 @@ impl Renderer {
         );
 
         // The filters, each from the last result to the next buffer.
+        let (filters, upsample) = filter_chain(a);
         let mut e = &img.irradiance;
-        for (filter, out) in filter_chain(a)
-            .into_iter()
-            .zip([&img.filtered_low, &img.filtered])
-        {
+        for filter in filters {
             let out = match filter {
-                Filter::Discontinuity => out,
-                _ => &img.filtered,
+                Filter::Discontinuity => &img.filtered_low,
+                Filter::Fused => &img.filtered,
             };
             let bind = self
                 .filter
@@ -1111,11 +1109,19 @@ impl Renderer {
                 mirror_e,
             ],
         );
-        let i = stage("compose");
+        // With downsampling (two-pass filters), compose upsamples E as it writes each pixel:
+        // a pass of its own took 0.036 ms of the H200 at 800 x 600 and 0.11 at 1920 x 1080
+        // (docs/PERFORMANCE.md attempt 52).
+        let name = if upsample {
+            "upsample + compose"
+        } else {
+            "compose"
+        };
+        let i = stage(name);
         rec.dispatch(
             i,
-            "compose",
-            &self.compose.steps(full.0, full.1),
+            name,
+            &self.compose.steps(full.0, full.1, upsample),
             scene,
             &compose_bind,
             None,
@@ -1139,23 +1145,17 @@ pub fn low_resolution(settings: &RenderSettings) -> (u32, u32) {
     (settings.width.div_ceil(s), settings.height.div_ceil(s))
 }
 
-/// The filters an acceleration set-up runs on the indirect term, in order.
-pub fn filter_chain(a: &Accelerations) -> Vec<Filter> {
+/// The filters an acceleration set-up runs on the indirect term, in order, and whether
+/// the compose pass then upsamples their result (joint bilateral upsampling, the second
+/// of the two passes of [`FilterMode::TwoPass`]).
+pub fn filter_chain(a: &Accelerations) -> (Vec<Filter>, bool) {
     let interleaved = a.interleave.0 * a.interleave.1 > 1;
     let downsampled = a.downsample > 1;
     match a.filter {
-        _ if !interleaved && !downsampled => vec![],
-        FilterMode::Fused => vec![Filter::Fused],
-        FilterMode::TwoPass => {
-            let mut v = vec![];
-            if interleaved {
-                v.push(Filter::Discontinuity);
-            }
-            if downsampled {
-                v.push(Filter::Upsample);
-            }
-            v
-        }
+        _ if !interleaved && !downsampled => (vec![], false),
+        FilterMode::Fused => (vec![Filter::Fused], false),
+        FilterMode::TwoPass if interleaved => (vec![Filter::Discontinuity], downsampled),
+        FilterMode::TwoPass => (vec![], downsampled),
     }
 }
 

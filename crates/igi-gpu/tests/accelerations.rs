@@ -12,7 +12,7 @@ use igi_core::image::{rel_mse, Image};
 use igi_core::scene::{load_scene, Camera, PointLight, Scene};
 use igi_core::settings::{Accelerations, FilterMode, OutputBuffer, RenderSettings};
 use igi_gpu::layout::FrameParams;
-use igi_gpu::passes::filter::{Filter, FilterPass};
+use igi_gpu::passes::compose::ComposePass;
 use igi_gpu::scene_buffers::{storage_buffer, SceneBuffers};
 use igi_gpu::GpuContext;
 
@@ -119,9 +119,10 @@ fn imperfect_visibility_only_adds_occlusion() {
     assert!(darker > 100, "only {darker} samples darker");
 }
 
-/// Run one filter on a synthetic G-buffer: `w` x `h` pixels whose left half is a floor
-/// (normal +y) and right half a wall (normal +x), both at depth 1, with the low-resolution
-/// input `low` (downsample `s`, no interleaving).
+/// Upsample (the compose pass's joint bilateral upsampling, writing E) on a synthetic
+/// G-buffer: `w` x `h` pixels whose left half is a floor (normal +y) and right half a wall
+/// (normal +x), both at depth 1, with the low-resolution input `low` (downsample `s`, no
+/// interleaving).
 fn run_upsampler(ctx: &GpuContext, w: u32, h: u32, s: u32, low: &[f32]) -> Vec<[f32; 4]> {
     // A scene only to have bind group 0.
     let tri = flat_triangle([Vec3::ZERO, Vec3::X, Vec3::Y], 0);
@@ -141,7 +142,7 @@ fn run_upsampler(ctx: &GpuContext, w: u32, h: u32, s: u32, low: &[f32]) -> Vec<[
     );
     let bvh = Bvh::build(&scene.triangles);
     let scene_buffers = SceneBuffers::upload(ctx, &scene, &bvh).unwrap();
-    let filter = FilterPass::new(&ctx.device, &scene_buffers.layout);
+    let compose = ComposePass::new(&ctx.device, &scene_buffers.layout);
     let (lw, lh) = (w.div_ceil(s), h.div_ceil(s));
     let params = FrameParams {
         width: w,
@@ -156,6 +157,8 @@ fn run_upsampler(ctx: &GpuContext, w: u32, h: u32, s: u32, low: &[f32]) -> Vec<[
         upsample_depth: 1,
         depth_threshold: 0.1,
         normal_threshold: 0.9,
+        // E itself (compose.wgsl's output 3).
+        output: 3,
         ..FrameParams::default()
     };
     let mut positions = vec![];
@@ -182,14 +185,19 @@ fn run_upsampler(ctx: &GpuContext, w: u32, h: u32, s: u32, low: &[f32]) -> Vec<[
     let pos = storage_buffer(ctx, "pos", bytemuck::cast_slice(&positions)).unwrap();
     let nrm = storage_buffer(ctx, "nrm", bytemuck::cast_slice(&normals)).unwrap();
     let inp = storage_buffer(ctx, "in", bytemuck::cast_slice(&input)).unwrap();
-    let out = storage_buffer(ctx, "out", &vec![0u8; (w * h * 16) as usize]).unwrap();
-    let bind = filter.bind(&ctx.device, &[&uniform, &pos, &nrm, &inp, &out]);
+    let zeros = vec![0u8; (w * h * 16) as usize];
+    let out = storage_buffer(ctx, "out", &zeros).unwrap();
+    let zero = storage_buffer(ctx, "zero", &zeros).unwrap();
+    let bind = compose.bind(
+        &ctx.device,
+        &[&uniform, &zero, &zero, &inp, &out, &pos, &nrm, &zero, &zero],
+    );
     let mut encoder = ctx.device.create_command_encoder(&Default::default());
     {
         let mut pass = encoder.begin_compute_pass(&Default::default());
         pass.set_bind_group(0, &scene_buffers.bind_group, &[]);
         pass.set_bind_group(1, &bind, &[]);
-        for (pipeline, groups) in filter.steps(Filter::Upsample, (w, h), (lw, lh)) {
+        for (pipeline, groups) in compose.steps(w, h, true) {
             pass.set_pipeline(pipeline);
             pass.dispatch_workgroups(groups[0], groups[1], groups[2]);
         }

@@ -226,8 +226,7 @@ fn bench_runs_tiny_and_its_json_parses() {
             "vpl list",
             "indirect",
             "discontinuity",
-            "upsample",
-            "compose"
+            "upsample + compose"
         ]
     );
     assert_eq!(run.rays.primary, 32 * 32);

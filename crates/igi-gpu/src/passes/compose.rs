@@ -1,12 +1,16 @@
-//! Compose (paper section 4, last stage): L = direct + (rho / pi) E, linear radiance.
-//! See `shaders/compose.wgsl`.
+//! Compose (paper section 4, last stage): L = direct + (rho / pi) E, linear radiance,
+//! with E at full resolution or upsampled on the way (joint bilateral upsampling, paper
+//! section 4.2). See `shaders/compose.wgsl`.
 
 use super::{bind, image_groups, pass_layout, pipeline};
 use crate::scene_buffers::{READ, UNIFORM, WRITE};
 
 pub struct ComposePass {
     pub layout: wgpu::BindGroupLayout,
+    /// E read at full resolution (`main`).
     pipeline: wgpu::ComputePipeline,
+    /// E upsampled from the indirect term's resolution (`main_upsampled`).
+    upsampled: wgpu::ComputePipeline,
 }
 
 impl ComposePass {
@@ -18,8 +22,10 @@ impl ComposePass {
             "compose",
             &[UNIFORM, READ, READ, READ, WRITE, READ, READ, READ, READ],
         );
+        let layouts = [scene_layout, &layout];
         ComposePass {
-            pipeline: pipeline(device, "compose", "main", &[scene_layout, &layout]),
+            pipeline: pipeline(device, "compose", "main", &layouts),
+            upsampled: pipeline(device, "compose", "main_upsampled", &layouts),
             layout,
         }
     }
@@ -28,7 +34,19 @@ impl ComposePass {
         bind(device, "compose", &self.layout, buffers)
     }
 
-    pub fn steps(&self, width: u32, height: u32) -> [(&wgpu::ComputePipeline, [u32; 3]); 1] {
-        [(&self.pipeline, image_groups(width, height))]
+    /// The dispatch over a `width` x `height` image; with `upsample`, the E buffer bound
+    /// is at the indirect term's resolution and is upsampled pixel by pixel.
+    pub fn steps(
+        &self,
+        width: u32,
+        height: u32,
+        upsample: bool,
+    ) -> [(&wgpu::ComputePipeline, [u32; 3]); 1] {
+        let pipeline = if upsample {
+            &self.upsampled
+        } else {
+            &self.pipeline
+        };
+        [(pipeline, image_groups(width, height))]
     }
 }

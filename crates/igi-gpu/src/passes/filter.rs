@@ -1,6 +1,7 @@
 //! The filters of the accelerated indirect term (paper sections 4.2 and 4.3): the
-//! discontinuity buffer, joint bilateral upsampling, and the two fused in one pass (the
-//! paper's future work). See `shaders/filter.wgsl`.
+//! discontinuity buffer, and it fused with upsampling in one pass (the paper's future
+//! work). Joint bilateral upsampling on its own is done by the compose pass as it writes
+//! each pixel. See `shaders/filter.wgsl`.
 
 use super::{bind, image_groups, pass_layout, pipeline};
 use crate::scene_buffers::{READ, UNIFORM, WRITE};
@@ -8,7 +9,6 @@ use crate::scene_buffers::{READ, UNIFORM, WRITE};
 pub struct FilterPass {
     pub layout: wgpu::BindGroupLayout,
     discontinuity: wgpu::ComputePipeline,
-    upsample: wgpu::ComputePipeline,
     fused: wgpu::ComputePipeline,
 }
 
@@ -16,7 +16,6 @@ pub struct FilterPass {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Filter {
     Discontinuity,
-    Upsample,
     Fused,
 }
 
@@ -24,7 +23,6 @@ impl Filter {
     pub fn stage_name(self) -> &'static str {
         match self {
             Filter::Discontinuity => "discontinuity",
-            Filter::Upsample => "upsample",
             Filter::Fused => "fused filter",
         }
     }
@@ -37,7 +35,6 @@ impl FilterPass {
         let layouts = [scene_layout, &layout];
         FilterPass {
             discontinuity: pipeline(device, "filter", "discontinuity", &layouts),
-            upsample: pipeline(device, "filter", "upsample", &layouts),
             fused: pipeline(device, "filter", "fused", &layouts),
             layout,
         }
@@ -48,7 +45,7 @@ impl FilterPass {
     }
 
     /// The dispatch of `filter`: the discontinuity buffer runs at the indirect term's
-    /// resolution, the others at full resolution.
+    /// resolution, the fused filter at full resolution.
     pub fn steps(
         &self,
         filter: Filter,
@@ -57,7 +54,6 @@ impl FilterPass {
     ) -> [(&wgpu::ComputePipeline, [u32; 3]); 1] {
         match filter {
             Filter::Discontinuity => [(&self.discontinuity, image_groups(low.0, low.1))],
-            Filter::Upsample => [(&self.upsample, image_groups(full.0, full.1))],
             Filter::Fused => [(&self.fused, image_groups(full.0, full.1))],
         }
     }

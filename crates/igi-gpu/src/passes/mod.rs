@@ -12,12 +12,16 @@ pub mod vpl;
 use crate::profiler::Profiler;
 use crate::scene_buffers::buffer_entry;
 
-/// A pass's own WGSL and whether it gathers from VPLs (then it declares `vpls` and
-/// `vpl_header`, and `gather.wgsl` is composed in).
+/// A pass's own WGSL, whether it gathers from VPLs (then it declares `vpls` and
+/// `vpl_header`, and `gather.wgsl` is composed in) and whether it upsamples (then it
+/// declares the G-buffer's position and normal and `low_irradiance`, and `upsample.wgsl`
+/// is composed in).
 pub struct PassSource {
     pub name: &'static str,
     pub wgsl: &'static str,
     pub gathers: bool,
+    /// Whether it is composed with upsample.wgsl (joint bilateral upsampling).
+    pub upsamples: bool,
 }
 
 /// Each pass's own WGSL, by name (composed with the shared modules by `shader::compose`).
@@ -26,36 +30,43 @@ pub const SOURCES: &[PassSource] = &[
         name: "vpl",
         wgsl: include_str!("../shaders/vpl.wgsl"),
         gathers: false,
+        upsamples: false,
     },
     PassSource {
         name: "direct",
         wgsl: include_str!("../shaders/direct.wgsl"),
         gathers: true,
+        upsamples: false,
     },
     PassSource {
         name: "indirect",
         wgsl: include_str!("../shaders/indirect.wgsl"),
         gathers: true,
+        upsamples: false,
     },
     PassSource {
         name: "filter",
         wgsl: include_str!("../shaders/filter.wgsl"),
         gathers: false,
+        upsamples: true,
     },
     PassSource {
         name: "rays",
         wgsl: include_str!("../shaders/rays.wgsl"),
         gathers: false,
+        upsamples: false,
     },
     PassSource {
         name: "compose",
         wgsl: include_str!("../shaders/compose.wgsl"),
         gathers: false,
+        upsamples: true,
     },
     PassSource {
         name: "display",
         wgsl: include_str!("../shaders/display.wgsl"),
         gathers: false,
+        upsamples: false,
     },
 ];
 

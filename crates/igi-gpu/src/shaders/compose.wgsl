@@ -3,7 +3,10 @@
 // when an image is written. `params.output` picks another buffer for inspection (the
 // viewer's buffer choice): direct (with the indirect light seen in mirrors), indirect,
 // E, normals or depth of the primary hits.
-// `irradiance_in` is E at full resolution: the indirect pass's output, or the last filter's.
+// Two entry points: `main` reads E at full resolution (`irradiance_in`: the indirect
+// pass's output, or the fused filter's); `main_upsampled` upsamples it from the indirect
+// term's resolution (`irradiance_in` then holds the indirect pass's or the discontinuity
+// buffer's output) with the joint bilateral upsampler of upsample.wgsl.
 
 @group(1) @binding(1) var<storage, read> direct_in: array<vec4<f32>>;
 @group(1) @binding(2) var<storage, read> gbuf_albedo: array<vec4<f32>>;
@@ -16,18 +19,40 @@
 @group(1) @binding(7) var<storage, read> mirror_weight: array<vec4<f32>>;
 @group(1) @binding(8) var<storage, read> mirror_irradiance: array<vec4<f32>>;
 
+// The low-resolution E that main_upsampled gathers from (upsample.wgsl).
+fn low_irradiance(i: u32) -> vec3<f32> {
+    return irradiance_in[i].xyz;
+}
+
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (gid.x >= params.width || gid.y >= params.height) {
         return;
     }
     let pixel = gid.y * params.width + gid.x;
+    compose_pixel(pixel, irradiance_in[pixel].xyz);
+}
+
+@compute @workgroup_size(8, 8)
+fn main_upsampled(@builtin(global_invocation_id) gid: vec3<u32>) {
+    if (gid.x >= params.width || gid.y >= params.height) {
+        return;
+    }
+    let pixel = gid.y * params.width + gid.x;
+    var e = vec3<f32>(0.0);
+    if (gbuf_position[pixel].w > 0.0) {
+        e = upsampled_irradiance(gid.x, gid.y, pixel);
+    }
+    compose_pixel(pixel, e);
+}
+
+// Writes pixel `pixel` of the chosen output, E there being `e`.
+fn compose_pixel(pixel: u32, e: vec3<f32>) {
     var direct = direct_in[pixel].xyz;
     let mirrored = mirror_weight[pixel];
     if (mirrored.w > 0.0) {
         direct += mirrored.xyz * mirror_irradiance[pixel].xyz;
     }
-    let e = irradiance_in[pixel].xyz;
     let indirect = gbuf_albedo[pixel].xyz / PI * e;
     var c = direct + indirect;
     // position.w > 0 where the primary ray hit a surface.

@@ -1,21 +1,25 @@
 // filter.wgsl: back from the interleaved, downsampled indirect term to a smooth
 // full-resolution one (paper sections 4.2 and 4.3, and the combined pass of its future
-// work). Three entry points, each its own pass:
+// work). Two entry points, each its own pass:
 // - discontinuity: at the indirect resolution, each pixel averages the n x m window
 //   around it over the neighbours that are geometrically continuous with it (depth and
 //   normal thresholds): every subset of the regular pattern is in every such window.
-// - upsample: joint bilateral upsampling to full resolution,
-//   S(p) = 1/k sum_q I_q f(|p - q|) w(N_p . N_q) [x depth weight], f a spatial Gaussian
-//   over low-resolution neighbours, w the paper's cosine (to a power, 1 by default).
-// - fused: both at once from the raw interleaved term: for each of the four low-res
-//   pixels around p (bilinear weights), the n x m window around it, each sample weighed
-//   by its continuity with the full-resolution pixel p itself.
-// G-buffer samples of low-resolution pixels are those of their representative pixels.
+// - fused: discontinuity and upsampling at once from the raw interleaved term: for each
+//   of the four low-res pixels around p (bilinear weights), the n x m window around it,
+//   each sample weighed by its continuity with the full-resolution pixel p itself.
+// Joint bilateral upsampling on its own (section 4.2) happens in compose.wgsl, as it
+// writes each pixel (upsample.wgsl). G-buffer samples of low-resolution pixels are those
+// of their representative pixels.
 
 @group(1) @binding(1) var<storage, read> gbuf_position: array<vec4<f32>>;
 @group(1) @binding(2) var<storage, read> gbuf_normal: array<vec4<f32>>;
 @group(1) @binding(3) var<storage, read> filter_in: array<vec4<f32>>;
 @group(1) @binding(4) var<storage, read_write> filter_out: array<vec4<f32>>;
+
+// The low-resolution E that upsample.wgsl gathers from.
+fn low_irradiance(i: u32) -> vec3<f32> {
+    return filter_in[i].xyz;
+}
 
 // Whether full-resolution G-buffer samples a and b lie on one continuous surface.
 fn continuous(a: u32, b: u32) -> bool {
@@ -66,66 +70,6 @@ fn discontinuity(@builtin(global_invocation_id) gid: vec3<u32>) {
     filter_out[low] = vec4<f32>(sum / max(weight, 1.0), 1.0);
 }
 
-// Low-resolution coordinate of full-resolution pixel p's centre, in the frame where
-// low-res pixel c sits at its representative pixel's centre.
-fn low_coordinate(p: u32) -> f32 {
-    let s = f32(params.downsample);
-    return (f32(p) - f32(params.downsample / 2u)) / s;
-}
-
-// Range weight of the upsampler between full-resolution pixel p and sample q.
-fn range_weight(p: u32, q: u32) -> f32 {
-    if (gbuf_position[q].w <= 0.0) {
-        return 0.0;
-    }
-    let np = gbuf_normal[p];
-    let nq = gbuf_normal[q];
-    var w = pow(max(dot(np.xyz, nq.xyz), 0.0), params.normal_power);
-    if (params.upsample_depth != 0u) {
-        let d = (np.w - nq.w) / (params.depth_threshold * np.w);
-        w *= exp(-0.5 * d * d);
-    }
-    return w;
-}
-
-// What a full-resolution pixel gathers from low-resolution samples: the weighted sum,
-// and the nearest surface sample as the fallback where every weight is zero (a thin
-// feature between samples, every neighbour facing away).
-struct Gathered {
-    sum: vec3<f32>,
-    weight: f32,
-    nearest: vec3<f32>,
-    nearest_d2: f32,
-}
-
-fn new_gathered() -> Gathered {
-    return Gathered(vec3<f32>(0.0), 0.0, vec3<f32>(0.0), 1e30);
-}
-
-// Add low-resolution sample (x, y), inside the image, with weight w, at squared
-// distance d2 (low-resolution pixels) from the pixel being filtered.
-fn gather_sample(g: ptr<function, Gathered>, x: i32, y: i32, w: f32, d2: f32) {
-    let q = representative_pixel(u32(x), u32(y));
-    let value = filter_in[u32(y) * params.low_width + u32(x)].xyz;
-    (*g).sum += w * value;
-    (*g).weight += w;
-    if (gbuf_position[q].w > 0.0 && d2 < (*g).nearest_d2) {
-        (*g).nearest_d2 = d2;
-        (*g).nearest = value;
-    }
-}
-
-fn gathered_value(g: Gathered) -> vec3<f32> {
-    if (g.weight > 1e-6) {
-        return g.sum / g.weight;
-    }
-    return g.nearest;
-}
-
-fn inside_low(x: i32, y: i32) -> bool {
-    return x >= 0 && y >= 0 && x < i32(params.low_width) && y < i32(params.low_height);
-}
-
 // The full-resolution pixel of `gid`, or NO_HIT outside the image or where no surface
 // was hit (its E is written as zero here).
 fn surface_pixel(gid: vec3<u32>) -> u32 {
@@ -138,35 +82,6 @@ fn surface_pixel(gid: vec3<u32>) -> u32 {
         return NO_HIT;
     }
     return pixel;
-}
-
-@compute @workgroup_size(8, 8)
-fn upsample(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let pixel = surface_pixel(gid);
-    if (pixel == NO_HIT) {
-        return;
-    }
-    let u = low_coordinate(gid.x);
-    let v = low_coordinate(gid.y);
-    let bx = i32(floor(u));
-    let by = i32(floor(v));
-    var g = new_gathered();
-    let inv_two_sigma2 = 0.5 / (params.upsample_sigma * params.upsample_sigma);
-    for (var j = -1; j <= 2; j += 1) {
-        for (var i = -1; i <= 2; i += 1) {
-            let x = bx + i;
-            let y = by + j;
-            if (!inside_low(x, y)) {
-                continue;
-            }
-            let dx = f32(x) - u;
-            let dy = f32(y) - v;
-            let d2 = dx * dx + dy * dy;
-            let w = exp(-d2 * inv_two_sigma2) * range_weight(pixel, representative_pixel(u32(x), u32(y)));
-            gather_sample(&g, x, y, w, d2);
-        }
-    }
-    filter_out[pixel] = vec4<f32>(gathered_value(g), 1.0);
 }
 
 @compute @workgroup_size(8, 8)
