@@ -433,9 +433,9 @@ fn height(c: &BvhChild, heights: &[u8]) -> u8 {
 /// best of the node's four, and only if it keeps every interior node above `max_depth`
 /// (the traversal stack's bound). Made as each node's subtree is finished, while it is in
 /// cache, this is one bottom-up pass over the tree in which every node settles before its
-/// parent looks at it. On the conference room: SAH cost 35.6 -> 33.0, the same as three
-/// separate passes over the finished tree, which cost 12-20 ms more of the 2-core
-/// machine's build (docs/PERFORMANCE.md attempts 48 and 49).
+/// parent looks at it. On the conference room: SAH cost 35.6 -> 33.0, as with three
+/// separate passes over the finished tree, for 3-9% less build time on the 2-core machine
+/// (docs/PERFORMANCE.md attempts 48 and 49).
 fn rotate_locally(
     nodes: &mut [BvhNode],
     heights: &mut [u8],
