@@ -917,8 +917,8 @@ impl Renderer {
         );
 
         // The indirect pass over the mirror record (the mirror indirect stage below),
-        // gathering only at the pixels the direct pass listed; its bind groups and those
-        // of the list, in scenes with mirrors.
+        // gathering only at the pixels the direct pass listed; its bind groups, those of
+        // the list and that of the mirror chains' dispatch, in scenes with mirrors.
         let mirror_groups = self.has_mirrors.then(|| {
             let bind = self.indirect.bind(
                 device,
@@ -935,7 +935,8 @@ impl Renderer {
             let (list, args) = self
                 .indirect
                 .bind_list(device, &img.mirror_list, &img.mirror_args);
-            (bind, list, args)
+            let chain_args = self.direct.bind_args(device, &img.chain_args);
+            (bind, list, args, chain_args)
         });
         let one_range = GatherRanges {
             bind_group: range_group,
@@ -944,7 +945,6 @@ impl Renderer {
         };
         let args_step = [self.indirect.args_step()];
         let chain_args_step = [self.direct.args_step()];
-        let chain_args_bind = self.direct.bind_args(device, &img.chain_args);
         let compact_step = [compact];
         let mut list_parts = vec![Dispatches {
             steps: &compact_step,
@@ -954,7 +954,7 @@ impl Renderer {
             group3: None,
             indirect: None,
         }];
-        if let Some((mirror_bind, _, args_bind)) = &mirror_groups {
+        if let Some((mirror_bind, _, args_bind, chain_args_bind)) = &mirror_groups {
             // Sizes the mirror indirect dispatch from the list's length.
             list_parts.push(Dispatches {
                 steps: &args_step,
@@ -971,7 +971,7 @@ impl Renderer {
                 scene,
                 pass: &direct_first,
                 ranges: Some(&one_range),
-                group3: Some(&chain_args_bind),
+                group3: Some(chain_args_bind),
                 indirect: None,
             });
         }
@@ -1000,7 +1000,7 @@ impl Renderer {
         // the indirect stage, in one compute pass, the two took as long as one after the
         // other: both fill the GPU. docs/PERFORMANCE.md, attempt 22.)
         let mut mirror_e = &img.mirror_irradiance;
-        if let Some((mirror_bind, list_bind, _)) = &mirror_groups {
+        if let Some((mirror_bind, list_bind, _, _)) = &mirror_groups {
             let list_pipeline = self.indirect.list_pipeline(iv);
             let i = stage("mirror indirect");
             rec.stage(
