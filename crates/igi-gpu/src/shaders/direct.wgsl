@@ -8,7 +8,7 @@
 // The pass walks twice. Its first walk (`main`) gathers no VPLs, so that it can run
 // beside VPL shooting, before any VPL exists (frame.rs: the two are not kept apart by a
 // barrier); it does everything else and lists the pixels whose chain has hits seen in a
-// mirror seen in a mirror (and flags them: albedo w = 2). Later walks (`chains_main`,
+// mirror seen in a mirror. Later walks (`chains_main`,
 // after VPL shooting, dispatched over that list) follow only those chains again and add
 // the VPL light of their range (one range on GPUs, several on llvmpipe, see gather.wgsl)
 // at those hits.
@@ -99,10 +99,8 @@ fn shade(x: u32, y: u32) {
         mirror_position[pixel] = vec4<f32>(0.0);
         mirror_weight[pixel] = vec4<f32>(0.0);
     } else {
-        // Later walks only add VPL light at hits seen in a mirror seen in a mirror.
-        if (gbuf_albedo[pixel].w < 2.0) {
-            return;
-        }
+        // Later walks (over the listed pixels only) add VPL light at hits seen in a mirror
+        // seen in a mirror.
         radiance = direct_out[pixel].xyz;
     }
     var traced = 0u;
@@ -123,9 +121,7 @@ fn shade(x: u32, y: u32) {
             gbuf_position[pixel] = vec4<f32>(s.position, 1.0);
             gbuf_normal[pixel] = vec4<f32>(s.shading_normal, hit.t);
             gbuf_geometric[pixel] = vec4<f32>(s.geometric_normal, 0.0);
-            // w: 1 where the pixel's mirror chain goes on, 2 where it needs later walks.
-            let mirrored = max(s.mirror.x, max(s.mirror.y, s.mirror.z)) > 0.0;
-            gbuf_albedo[pixel] = vec4<f32>(s.diffuse, select(0.0, 1.0, mirrored));
+            gbuf_albedo[pixel] = vec4<f32>(s.diffuse, 0.0);
         }
         if (max(s.diffuse.x, max(s.diffuse.y, s.diffuse.z)) > 0.0) {
             var e = vec3<f32>(0.0);
@@ -167,7 +163,6 @@ fn shade(x: u32, y: u32) {
         count_rays(RAY_PRIMARY, 1u);
         count_rays(RAY_MIRROR, traced - 1u);
         if (chained) {
-            gbuf_albedo[pixel].w = 2.0;
             let slot = atomicAdd(&chain_list[0], 1u);
             atomicStore(&chain_list[2u + slot], pixel);
         }
