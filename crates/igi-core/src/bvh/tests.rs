@@ -92,6 +92,20 @@ fn check_structure(bvh: &Bvh, tris: &[[Vec3; 3]]) {
     }
     assert!(leaf_slots.iter().all(|&s| s), "a slot in no leaf");
     assert!(node_seen.iter().all(|&s| s), "an unreachable node");
+    // Laid out depth first, child a's subtree right after its parent, then child b's:
+    // the walk in that order meets the nodes in index order.
+    let mut order = vec![0u32];
+    let mut next = 0u32;
+    while let Some(node) = order.pop() {
+        assert_eq!(node, next, "node {node} out of depth-first order");
+        next += 1;
+        let nd = bvh.nodes[node as usize];
+        for c in [nd.b(), nd.a()] {
+            if !c.is_leaf() && c.min.x <= c.max.x {
+                order.push(c.index);
+            }
+        }
+    }
     assert!(bvh.build_stats.max_depth <= MAX_DEPTH);
     // The statistics gathered while building are those of the finished tree.
     let mut walked = super::build::stats_by_walk(bvh);
