@@ -24,7 +24,6 @@
 
 use std::time::Instant;
 
-use bytemuck::Zeroable;
 use glam::{Vec3, Vec3A};
 
 use super::{
@@ -338,8 +337,11 @@ where
     }
     let mut ids: Vec<u32> = (0..count as u32).collect();
 
-    let mut nodes = Vec::with_capacity(count);
-    let mut heights = Vec::with_capacity(count);
+    // Room for count - 1 interior nodes, the most a tree of count leaves' triangles has;
+    // zeroed by the allocator, so that the parts no subtree writes (see Region) are never
+    // touched.
+    let mut nodes: Vec<BvhNode> = bytemuck::zeroed_vec(count.max(2) - 1);
+    let mut heights = vec![0u8; nodes.len()];
     let mut tally = Tally::default();
     let par_levels = threads().next_power_of_two().trailing_zeros() + 1;
     let root = build_node(
@@ -351,8 +353,12 @@ where
             cbounds,
             depth: 0,
         },
-        &mut nodes,
-        &mut heights,
+        &mut Region {
+            nodes: &mut nodes,
+            heights: &mut heights,
+            base: 0,
+            used: 0,
+        },
         &mut tally,
         &Limits {
             max_depth,
@@ -365,11 +371,7 @@ where
     if root.count > 0 {
         // A root that is a leaf still needs an interior node 0 to hold its box; the leaf
         // is its child, at depth 1.
-        debug_assert!(nodes.is_empty());
-        nodes.push(BvhNode::new(
-            bounds.child(root.index, root.count),
-            BvhChild::EMPTY,
-        ));
+        nodes[0] = BvhNode::new(bounds.child(root.index, root.count), BvhChild::EMPTY);
     }
     drop(prims);
 
@@ -405,18 +407,72 @@ where
 /// Rotations a node may make on the way up of the build (see [`rotate_locally`]).
 const ROTATION_BUDGET: u32 = 8;
 
+/// The part of the tree's node array (and of the nodes' heights) that a subtree writes:
+/// nodes at global indices `base ..`, `used` of them so far. A subtree of n triangles
+/// gets n - 1 places, the most it can need; one built on another thread gets a region
+/// of its own, carved from its parent's, so that the two sides of a split are built in
+/// place side by side. The places a subtree leaves unused stay zero and unreachable, and
+/// the depth-first layout drops them. (The right subtree used to be built in a vector
+/// of its own and copied behind the left one: 6 ms of copies, mostly after joins, on the
+/// conference room; docs/PERFORMANCE.md attempt 63.)
+struct Region<'a> {
+    nodes: &'a mut [BvhNode],
+    heights: &'a mut [u8],
+    base: usize,
+    used: usize,
+}
+
+impl Region<'_> {
+    /// A new node's global index.
+    fn push(&mut self) -> usize {
+        self.used += 1;
+        self.base + self.used - 1
+    }
+
+    fn node(&self, i: usize) -> BvhNode {
+        self.nodes[i - self.base]
+    }
+
+    fn set(&mut self, i: usize, node: BvhNode, height: u8) {
+        self.nodes[i - self.base] = node;
+        self.heights[i - self.base] = height;
+    }
+
+    /// Levels below a child: 0 for a leaf, its node's height for an interior node.
+    fn height(&self, c: &BvhChild) -> u8 {
+        if is_node(c) {
+            self.heights[c.index as usize - self.base]
+        } else {
+            0
+        }
+    }
+
+    /// The rest of the region split for a node's two subtrees built side by side: the
+    /// left one (k triangles) gets k - 1 places, the right one the rest.
+    fn split(&mut self, k: usize) -> (Region<'_>, Region<'_>) {
+        let (ln, rn) = self.nodes[self.used..].split_at_mut(k - 1);
+        let (lh, rh) = self.heights[self.used..].split_at_mut(k - 1);
+        let base = self.base + self.used;
+        (
+            Region {
+                nodes: ln,
+                heights: lh,
+                base,
+                used: 0,
+            },
+            Region {
+                nodes: rn,
+                heights: rh,
+                base: base + k - 1,
+                used: 0,
+            },
+        )
+    }
+}
+
 /// Whether a child is an interior node (not a leaf, not the empty child of a root leaf).
 fn is_node(c: &BvhChild) -> bool {
     c.count == 0 && c.min.x <= c.max.x
-}
-
-/// Levels below a child: 0 for a leaf, its node's height for an interior node.
-fn height(c: &BvhChild, heights: &[u8]) -> u8 {
-    if is_node(c) {
-        heights[c.index as usize]
-    } else {
-        0
-    }
 }
 
 /// Kensler's tree rotations ("Tree Rotations for Improving Bounding Volume Hierarchies",
@@ -434,36 +490,25 @@ fn height(c: &BvhChild, heights: &[u8]) -> u8 {
 /// parent looks at it. On the conference room: SAH cost 35.6 -> 33.0, as with three
 /// separate passes over the finished tree, for 3-9% less build time on the 2-core machine
 /// (docs/PERFORMANCE.md attempts 48 and 49).
-fn rotate_locally(
-    nodes: &mut [BvhNode],
-    heights: &mut [u8],
-    i: usize,
-    depth: u32,
-    max_depth: u32,
-    budget: &mut u32,
-) {
+fn rotate_locally(tree: &mut Region, i: usize, depth: u32, max_depth: u32, budget: &mut u32) {
     while *budget > 0 {
-        let Some(y) = rotate_node(nodes, heights, i, depth, max_depth) else {
+        let Some(y) = rotate_node(tree, i, depth, max_depth) else {
             return;
         };
         *budget -= 1;
-        rotate_locally(nodes, heights, y, depth + 1, max_depth, budget);
-        let n = nodes[i];
-        heights[i] = 1 + height(&n.a(), heights).max(height(&n.b(), heights));
+        rotate_locally(tree, y, depth + 1, max_depth, budget);
+        let n = tree.node(i);
+        let h = 1 + tree.height(&n.a()).max(tree.height(&n.b()));
+        tree.set(i, n, h);
     }
 }
 
 /// The best rotation at node `i` (see [`rotate_locally`]), if one shrinks a box within
 /// the depth cap; returns the index of the child whose children changed.
-fn rotate_node(
-    nodes: &mut [BvhNode],
-    heights: &mut [u8],
-    i: usize,
-    depth: u32,
-    max_depth: u32,
-) -> Option<usize> {
-    let kids = [nodes[i].a(), nodes[i].b()];
-    let h = |c: &BvhChild| height(c, heights);
+fn rotate_node(tree: &mut Region, i: usize, depth: u32, max_depth: u32) -> Option<usize> {
+    let n = tree.node(i);
+    let kids = [n.a(), n.b()];
+    let h = |c: &BvhChild| tree.height(c);
     // (area saved, the side of x, the grandchild that moves up, the new heights of y and i)
     let mut best: Option<(f32, usize, usize, u8, u8)> = None;
     for side in 0..2 {
@@ -471,7 +516,7 @@ fn rotate_node(
         if !is_node(&y) {
             continue;
         }
-        let grand = &nodes[y.index as usize];
+        let grand = tree.node(y.index as usize);
         let g = [grand.a(), grand.b()];
         for k in 0..2 {
             let saved = y.half_area() - union(&x, &g[1 - k]).half_area();
@@ -488,14 +533,12 @@ fn rotate_node(
     }
     let (_, side, k, y_height, i_height) = best?;
     let (x, y) = (kids[side], kids[1 - side]);
-    let grand = nodes[y.index as usize];
+    let grand = tree.node(y.index as usize);
     let g = [grand.a(), grand.b()];
     let (up, stays) = (g[k], g[1 - k]);
-    nodes[y.index as usize] = larger_first(x, stays);
-    heights[y.index as usize] = y_height;
+    tree.set(y.index as usize, larger_first(x, stays), y_height);
     let y = union(&x, &stays).child(y.index, 0);
-    nodes[i] = larger_first(up, y);
-    heights[i] = i_height;
+    tree.set(i, larger_first(up, y), i_height);
     Some(y.index as usize)
 }
 
@@ -573,15 +616,14 @@ fn range_bounds(prims: &[PrimRef]) -> (Aabb, Aabb) {
     (b, c)
 }
 
-/// Builds the subtree of `task`; pushes its interior nodes to `out` (this node first)
-/// and their heights to `heights` (see [`rotate_locally`]), and returns the reference to
-/// it as a child (an interior node: count 0, index into `out`; or a leaf: count > 0,
+/// Builds the subtree of `task`; writes its interior nodes and their heights (see
+/// [`rotate_locally`]) into `tree` (this node first), and returns the reference to it as
+/// a child (an interior node: count 0, index into the node array; or a leaf: count > 0,
 /// index = first BVH slot) with its height (0 for a leaf). Each node makes its rotations
 /// as soon as its subtree is built.
 fn build_node(
     task: Task<'_>,
-    out: &mut Vec<BvhNode>,
-    heights: &mut Vec<u8>,
+    tree: &mut Region,
     tally: &mut Tally,
     limits: &Limits,
 ) -> (BvhChild, u8) {
@@ -629,9 +671,7 @@ fn build_node(
         }
     };
 
-    let slot = out.len();
-    out.push(BvhNode::zeroed());
-    heights.push(0);
+    let slot = tree.push();
     let depth = task.depth + 1;
     let (lp, rp) = task.prims.split_at_mut(k);
     let (li, ri) = task.ids.split_at_mut(k);
@@ -653,57 +693,29 @@ fn build_node(
     };
 
     let ((a, ha), (b, hb)) = if task.depth < limits.par_levels && n >= PARALLEL_MIN_PRIMS {
-        let mut right_nodes = Vec::with_capacity(n - k);
-        let mut right_heights = Vec::with_capacity(n - k);
         let mut right_tally = Tally::default();
+        let (mut left_tree, mut right_tree) = tree.split(k);
         let (a, b) = std::thread::scope(|s| {
-            let handle = s.spawn(|| {
-                build_node(
-                    right,
-                    &mut right_nodes,
-                    &mut right_heights,
-                    &mut right_tally,
-                    limits,
-                )
-            });
-            let a = build_node(left, out, heights, tally, limits);
+            let handle = s.spawn(|| build_node(right, &mut right_tree, &mut right_tally, limits));
+            let a = build_node(left, &mut left_tree, tally, limits);
             (a, handle.join().expect("BVH build thread panicked"))
         });
+        // This subtree now ends where the right one's nodes end (the left one's unused
+        // places stay a gap).
+        let right_end = right_tree.base + right_tree.used;
+        tree.used = right_end - tree.base;
         tally.merge(right_tally);
-        heights.extend(right_heights);
-        // The right subtree numbered its nodes from 0: move them behind the left one.
-        let offset = out.len() as u32;
-        out.extend(right_nodes.into_iter().map(|mut node| {
-            if node.a_count == 0 {
-                node.a_index += offset;
-            }
-            if node.b_count == 0 {
-                node.b_index += offset;
-            }
-            node
-        }));
-        let mut b = b;
-        if b.0.count == 0 {
-            b.0.index += offset;
-        }
         (a, b)
     } else {
-        let a = build_node(left, out, heights, tally, limits);
-        let b = build_node(right, out, heights, tally, limits);
+        let a = build_node(left, tree, tally, limits);
+        let b = build_node(right, tree, tally, limits);
         (a, b)
     };
-    out[slot] = larger_first(a, b);
-    heights[slot] = 1 + ha.max(hb);
+    tree.set(slot, larger_first(a, b), 1 + ha.max(hb));
     let mut budget = limits.rotation_budget;
-    rotate_locally(
-        out,
-        heights,
-        slot,
-        task.depth,
-        limits.max_depth,
-        &mut budget,
-    );
-    (task.bounds.child(slot as u32, 0), heights[slot])
+    rotate_locally(tree, slot, task.depth, limits.max_depth, &mut budget);
+    let node = task.bounds.child(slot as u32, 0);
+    (node, tree.height(&node))
 }
 
 /// Exact SAH sweep of a small range (2..=SMALL_RANGE primitives): for each axis the
