@@ -122,6 +122,17 @@ struct Limits {
     rotation_budget: u32,
 }
 
+impl Limits {
+    /// Subtrees on separate threads down to the level with about two per thread.
+    fn new(max_depth: u32, rotation_budget: u32) -> Limits {
+        Limits {
+            max_depth,
+            par_levels: threads().next_power_of_two().trailing_zeros() + 1,
+            rotation_budget,
+        }
+    }
+}
+
 /// The chosen split: bins `< bin` of `axis` go left.
 struct Split {
     axis: usize,
@@ -189,8 +200,7 @@ pub(super) fn build(triangles: &[Triangle]) -> Bvh {
     build_impl(
         triangles.len(),
         |i| triangles[i].v,
-        MAX_DEPTH,
-        ROTATION_BUDGET,
+        Limits::new(MAX_DEPTH, ROTATION_BUDGET),
     )
 }
 
@@ -198,9 +208,18 @@ pub(super) fn build_from_vertices(triangles: &[[Vec3; 3]]) -> Bvh {
     build_impl(
         triangles.len(),
         |i| triangles[i],
-        MAX_DEPTH,
-        ROTATION_BUDGET,
+        Limits::new(MAX_DEPTH, ROTATION_BUDGET),
     )
+}
+
+/// With every subtree built on the calling thread (the tree must be the same).
+#[cfg(test)]
+pub(super) fn build_on_one_thread(triangles: &[[Vec3; 3]]) -> Bvh {
+    let limits = Limits {
+        par_levels: 0,
+        ..Limits::new(MAX_DEPTH, ROTATION_BUDGET)
+    };
+    build_impl(triangles.len(), |i| triangles[i], limits)
 }
 
 /// With a lower depth cap, to test the cap without a pathological scene (a chain 60
@@ -214,15 +233,18 @@ pub(super) fn build_with_max_depth(triangles: &[[Vec3; 3]], max_depth: u32) -> B
     build_impl(
         triangles.len(),
         |i| triangles[i],
-        max_depth,
-        ROTATION_BUDGET,
+        Limits::new(max_depth, ROTATION_BUDGET),
     )
 }
 
 /// With another rotation budget per node (0: the tree as the splits left it).
 #[cfg(test)]
 pub(super) fn build_with_rotations(triangles: &[[Vec3; 3]], max_depth: u32, budget: u32) -> Bvh {
-    build_impl(triangles.len(), |i| triangles[i], max_depth, budget)
+    build_impl(
+        triangles.len(),
+        |i| triangles[i],
+        Limits::new(max_depth, budget),
+    )
 }
 
 fn threads() -> usize {
@@ -286,7 +308,7 @@ impl Tally {
     }
 }
 
-fn build_impl<F>(count: usize, tri: F, max_depth: u32, rotation_budget: u32) -> Bvh
+fn build_impl<F>(count: usize, tri: F, limits: Limits) -> Bvh
 where
     F: Fn(usize) -> [Vec3; 3] + Sync,
 {
@@ -343,7 +365,6 @@ where
     let mut nodes: Vec<BvhNode> = bytemuck::zeroed_vec(count.max(2) - 1);
     let mut heights = vec![0u8; nodes.len()];
     let mut tally = Tally::default();
-    let par_levels = threads().next_power_of_two().trailing_zeros() + 1;
     let root = build_node(
         Task {
             prims: &mut prims,
@@ -360,11 +381,7 @@ where
             used: 0,
         },
         &mut tally,
-        &Limits {
-            max_depth,
-            par_levels,
-            rotation_budget,
-        },
+        &limits,
     )
     .0;
     drop(heights);

@@ -756,6 +756,12 @@ fn parallel_build_is_deterministic_and_correct() {
     let b = Bvh::build_from_vertices(&tris);
     assert_eq!(a.nodes, b.nodes);
     assert_eq!(a.tri_order, b.tri_order);
+    // Subtrees built side by side in their own regions of the node array give the tree
+    // that one thread builds.
+    let one = super::build::build_on_one_thread(&tris);
+    assert_eq!(a.nodes, one.nodes);
+    assert_eq!(a.tri_order, one.tri_order);
+    assert_eq!(a.tri_verts, one.tri_verts);
     check_structure(&a, &tris);
     for _ in 0..300 {
         let o = rand_vec(&mut r, -120.0, 120.0);
