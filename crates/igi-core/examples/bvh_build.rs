@@ -90,18 +90,11 @@ fn main() {
     };
     let cam = scene.camera;
     let (w, h) = (scene.film.width.min(400), scene.film.height.min(300));
-    let fwd = (cam.target - cam.eye).normalize();
-    let right = fwd.cross(cam.up).normalize();
-    let up = right.cross(fwd);
-    let tan = (cam.fov_y_deg.to_radians() * 0.5).tan();
-    let aspect = w as f32 / h as f32;
     let t = Instant::now();
     let mut hit_points = vec![];
     for y in 0..h {
         for x in 0..w {
-            let px = (2.0 * (x as f32 + 0.5) / w as f32 - 1.0) * tan * aspect;
-            let py = (1.0 - 2.0 * (y as f32 + 0.5) / h as f32) * tan;
-            let d: Vec3 = (fwd + px * right + py * up).normalize();
+            let d = cam.pixel_dir(w, h, x, y);
             if let Some(hit) = bvh.trace_closest(cam.eye, d, f32::INFINITY) {
                 hit_points.push(cam.eye + d * hit.t);
             }

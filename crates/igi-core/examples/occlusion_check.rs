@@ -91,17 +91,11 @@ fn frame_segments(scene: &Scene, bvh: &Bvh, floor: f32, count: u32) -> Vec<(Vec3
     let vpls = shoot_vpls(scene, bvh, &DigitPermutations::new(0), 60, 3, 0, 0);
     let cam = scene.camera;
     let (w, h) = (scene.film.width, scene.film.height);
-    let forward = (cam.target - cam.eye).normalize();
-    let right = forward.cross(cam.up).normalize();
-    let up = right.cross(forward);
-    let tan = (cam.fov_y_deg.to_radians() * 0.5).tan();
     let mut out = vec![];
     let mut pair = 0u64;
     for y in (0..h).step_by(3) {
         for x in (0..w).step_by(3) {
-            let sx = (2.0 * (x as f32 + 0.5) / w as f32 - 1.0) * tan * w as f32 / h as f32;
-            let sy = (1.0 - 2.0 * (y as f32 + 0.5) / h as f32) * tan;
-            let dir = (forward + sx * right + sy * up).normalize();
+            let dir = cam.pixel_dir(w, h, x, y);
             let Some(hit) = bvh.trace_closest(cam.eye, dir, f32::INFINITY) else {
                 continue;
             };

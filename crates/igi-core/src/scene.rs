@@ -22,6 +22,27 @@ pub struct Camera {
     pub fov_y_deg: f32,
 }
 
+impl Camera {
+    /// The camera's orthonormal frame: forward, right (forward x up), and the true up.
+    pub fn basis(&self) -> (Vec3, Vec3, Vec3) {
+        let forward = (self.target - self.eye).normalize();
+        let right = forward.cross(self.up).normalize();
+        (forward, right, right.cross(forward))
+    }
+
+    /// The primary ray direction through the centre of pixel (x, y) of a width x height
+    /// image, y = 0 the top row: the CPU twin of frame.wgsl's `camera_ray_dir` (frame 0 of
+    /// an accumulation, which looks through pixel centres).
+    pub fn pixel_dir(&self, width: u32, height: u32, x: u32, y: u32) -> Vec3 {
+        let (forward, right, up) = self.basis();
+        let tan = (self.fov_y_deg.to_radians() * 0.5).tan();
+        let aspect = width as f32 / height as f32;
+        let sx = (2.0 * (x as f32 + 0.5) / width as f32 - 1.0) * tan * aspect;
+        let sy = (1.0 - 2.0 * (y as f32 + 0.5) / height as f32) * tan;
+        (forward + sx * right + sy * up).normalize()
+    }
+}
+
 /// The default image size, as `[film]` in the scene file.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Film {
@@ -119,5 +140,31 @@ impl Scene {
     /// Total power of all lights (RGB).
     pub fn total_power(&self) -> Vec3 {
         self.lights.iter().map(|l| l.power()).sum()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pixel_dir_looks_through_pixel_centres() {
+        // Looking down -z with y up and a 90 degree field: tan(fov / 2) = 1.
+        let cam = Camera {
+            eye: Vec3::new(1.0, 2.0, 3.0),
+            target: Vec3::new(1.0, 2.0, -7.0),
+            up: Vec3::Y,
+            fov_y_deg: 90.0,
+        };
+        assert_eq!(cam.basis(), (Vec3::NEG_Z, Vec3::X, Vec3::Y));
+        // 4 x 2 pixels: pixel (3, 0) is the top right one, its centre at x = 1.5 (aspect
+        // 2, three quarters of the half width) and y = 0.5 on the image plane at z = -1.
+        let d = cam.pixel_dir(4, 2, 3, 0);
+        assert!(
+            (d - Vec3::new(1.5, 0.5, -1.0).normalize()).length() < 1e-6,
+            "{d}"
+        );
+        // The centre pixel of an odd image looks straight ahead.
+        assert!((cam.pixel_dir(3, 3, 1, 1) - Vec3::NEG_Z).length() < 1e-6);
     }
 }

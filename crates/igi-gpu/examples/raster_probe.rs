@@ -10,8 +10,9 @@
 //! [FRAMES]` (default: the scene's film, 200 frames); prints the median GPU time of the
 //! draw, and how many pixels name the triangle the CPU twin's closest hit names.
 
-use glam::{Mat4, Vec3};
+use glam::Mat4;
 use igi_core::bvh::Bvh;
+use igi_core::scene::Camera;
 use igi_gpu::context::{AdapterChoice, GpuContext};
 use wgpu::util::DeviceExt;
 
@@ -63,8 +64,7 @@ fn run() -> Result<(), String> {
     let aspect = width as f32 / height as f32;
     let (lo, hi) = scene.bounds();
     let far = (hi - lo).length() * 2.0;
-    let view_proj = projection(cam.fov_y_deg.to_radians(), aspect, far * 1e-5, far)
-        * look_at(cam.eye, cam.target, cam.up);
+    let view_proj = projection(cam.fov_y_deg.to_radians(), aspect, far * 1e-5, far) * look_at(&cam);
     let positions: Vec<[f32; 3]> = scene
         .triangles
         .iter()
@@ -243,16 +243,10 @@ fn run() -> Result<(), String> {
     ctx.queue.submit([encoder.finish()]);
     let words: Vec<u32> = ctx.read_buffer(&readback).map_err(|e| e.to_string())?;
     let bvh = Bvh::build(&scene.triangles);
-    let fwd = (cam.target - cam.eye).normalize();
-    let right = fwd.cross(cam.up).normalize();
-    let up = right.cross(fwd);
-    let tan = (cam.fov_y_deg.to_radians() * 0.5).tan();
     let (mut same, mut both_miss, mut differ) = (0u64, 0u64, 0u64);
     for y in 0..height {
         for x in 0..width {
-            let sx = (2.0 * (x as f32 + 0.5) / width as f32 - 1.0) * tan * aspect;
-            let sy = (1.0 - 2.0 * (y as f32 + 0.5) / height as f32) * tan;
-            let d: Vec3 = (fwd + sx * right + sy * up).normalize();
+            let d = cam.pixel_dir(width, height, x, y);
             let traced = bvh
                 .trace_closest(cam.eye, d, f32::INFINITY)
                 .map(|h| bvh.tri_order[h.tri as usize] + 1)
@@ -272,11 +266,10 @@ fn run() -> Result<(), String> {
     Ok(())
 }
 
-/// World to camera space, looking down -z (right = forward x up, as igi's primary rays).
-fn look_at(eye: Vec3, target: Vec3, up: Vec3) -> Mat4 {
-    let f = (target - eye).normalize();
-    let s = f.cross(up).normalize();
-    let u = s.cross(f);
+/// World to camera space, looking down -z, in the frame of igi's primary rays.
+fn look_at(cam: &Camera) -> Mat4 {
+    let (f, s, u) = cam.basis();
+    let eye = cam.eye;
     Mat4::from_cols_array_2d(&[
         [s.x, s.y, s.z, -s.dot(eye)],
         [u.x, u.y, u.z, -u.dot(eye)],

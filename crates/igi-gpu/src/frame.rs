@@ -496,9 +496,7 @@ impl Renderer {
             )
         };
         let cam = &self.camera;
-        let forward = (cam.target - cam.eye).normalize();
-        let right = forward.cross(cam.up).normalize();
-        let up = right.cross(forward);
+        let (forward, right, up) = cam.basis();
         let min_dist = settings
             .min_dist
             .unwrap_or(igi_core::settings::DEFAULT_MIN_DIST_FRACTION * self.diagonal);

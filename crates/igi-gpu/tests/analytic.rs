@@ -47,18 +47,11 @@ fn point_light_over_diffuse_plane() {
         },
     );
 
-    // The camera of frame.wgsl, on the CPU.
-    let forward = (camera.target - camera.eye).normalize();
-    let right = forward.cross(camera.up).normalize();
-    let up = right.cross(forward);
-    let tan = (camera.fov_y_deg.to_radians() * 0.5).tan();
-    let aspect = settings.width as f32 / settings.height as f32;
     let mut worst = 0.0f32;
     for y in 0..settings.height {
         for x in 0..settings.width {
-            let sx = (2.0 * (x as f32 + 0.5) / settings.width as f32 - 1.0) * tan * aspect;
-            let sy = (1.0 - 2.0 * (y as f32 + 0.5) / settings.height as f32) * tan;
-            let d = (forward + sx * right + sy * up).normalize();
+            // The camera of frame.wgsl, on the CPU.
+            let d = camera.pixel_dir(settings.width, settings.height, x, y);
             let t = -camera.eye.y / d.y;
             assert!(t > 0.0, "every pixel sees the plane");
             let p = camera.eye + t * d;

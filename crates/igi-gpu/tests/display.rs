@@ -55,18 +55,11 @@ fn normals_and_depth_of_a_plane() {
         },
     )
     .image;
-    let forward = (camera.target - camera.eye).normalize();
-    let right = forward.cross(camera.up).normalize();
-    let up = right.cross(forward);
-    let tan = (camera.fov_y_deg.to_radians() * 0.5).tan();
-    let aspect = settings.width as f32 / settings.height as f32;
     let diagonal = scene.diagonal();
     for y in 0..settings.height {
         for x in 0..settings.width {
             assert_eq!(normals.pixel(x, y), [0.5, 1.0, 0.5], "pixel ({x}, {y})");
-            let sx = (2.0 * (x as f32 + 0.5) / settings.width as f32 - 1.0) * tan * aspect;
-            let sy = (1.0 - 2.0 * (y as f32 + 0.5) / settings.height as f32) * tan;
-            let d = (forward + sx * right + sy * up).normalize();
+            let d = camera.pixel_dir(settings.width, settings.height, x, y);
             let expected = -camera.eye.y / d.y / diagonal;
             let got = depth.pixel(x, y);
             assert!(
@@ -271,9 +264,7 @@ fn vpl_dots_are_drawn_where_the_vpls_are() {
     let dotted = draw(&ctx, &renderer, format, (w, h), &options);
 
     let camera = scene.camera;
-    let forward = (camera.target - camera.eye).normalize();
-    let right = forward.cross(camera.up).normalize();
-    let up = right.cross(forward);
+    let (forward, right, up) = camera.basis();
     let tan = (camera.fov_y_deg.to_radians() * 0.5).tan();
     let aspect = w as f32 / h as f32;
     let dots: Vec<(f32, f32)> = renderer

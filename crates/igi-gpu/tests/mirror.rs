@@ -8,23 +8,11 @@ mod common;
 use common::*;
 use glam::Vec3;
 use igi_core::bvh::{offset_ray_origin, Bvh};
-use igi_core::scene::{Camera, Scene};
+use igi_core::scene::Scene;
 use igi_core::settings::{InterleavePattern, OutputBuffer, RenderSettings};
 use igi_core::vpl::{reflect, surface_at};
 use igi_gpu::Renderer;
 use std::f32::consts::PI;
-
-/// The primary ray direction of pixel (x, y), as frame.wgsl makes it (frame 0).
-fn primary_dir(cam: &Camera, width: u32, height: u32, x: u32, y: u32) -> Vec3 {
-    let forward = (cam.target - cam.eye).normalize();
-    let right = forward.cross(cam.up).normalize();
-    let up = right.cross(forward);
-    let tan = (cam.fov_y_deg.to_radians() * 0.5).tan();
-    let aspect = width as f32 / height as f32;
-    let sx = (2.0 * (x as f32 + 0.5) / width as f32 - 1.0) * tan * aspect;
-    let sy = (1.0 - 2.0 * (y as f32 + 0.5) / height as f32) * tan;
-    (forward + sx * right + sy * up).normalize()
-}
 
 /// Irradiance at a surface point from the lights and (optionally) the VPLs, on the CPU
 /// with the GPU's formulas; `m` is the bounding distance of G.
@@ -84,7 +72,7 @@ fn chain_radiance(
 ) -> (Vec3, u32) {
     let m = settings.min_dist_for(scene);
     let cam = scene.camera;
-    let mut dir = primary_dir(&cam, settings.width, settings.height, x, y);
+    let mut dir = cam.pixel_dir(settings.width, settings.height, x, y);
     let mut origin = cam.eye;
     let mut throughput = Vec3::ONE;
     let (mut radiance, mut gathered) = (Vec3::ZERO, 0);
@@ -271,7 +259,7 @@ fn compare_interleaved(
         (0.0, 0.0, 0.0, 0.0, 0, 0);
     for y in 0..base.height {
         for x in 0..base.width {
-            let dir = primary_dir(&cam, base.width, base.height, x, y);
+            let dir = cam.pixel_dir(base.width, base.height, x, y);
             let Some(hit) = bvh.trace_closest(cam.eye, dir, f32::INFINITY) else {
                 continue;
             };
