@@ -1,9 +1,9 @@
 //! The frame (paper section 4): [`Renderer::encode_frame`] lists its passes in order —
 //! VPL shooting beside direct + specular, the VPL list, [the mirror chains], [mirror
-//! indirect and its filter], indirect diffuse, [its filters], compose — each a compute
-//! pass with its own timestamp pair (VPL shooting and direct + specular share one). The
-//! renderer owns the scene on the GPU, the passes and the frame's buffers; nothing is
-//! read back inside a frame.
+//! indirect beside] indirect diffuse, [the mirror discontinuity buffer beside] [its
+//! filter], compose — each stage with its own timestamp pair (passes side by side share
+//! one). The renderer owns the scene on the GPU, the passes and the frame's buffers;
+//! nothing is read back inside a frame.
 
 use crate::context::{GpuContext, GpuError, SMALLER_FRAME};
 use crate::layout::{FrameParams, Vpl};
@@ -877,11 +877,15 @@ impl Renderer {
                 },
             )
         };
-        // A frame that counts rays counts them all in one buffer (then with a barrier).
-        let beside = if self.counting {
-            scene
-        } else {
-            &self.scene.beside_bind_group
+        // Spare ray counters for the dispatches that run beside an earlier one (see
+        // `SceneBuffers::beside_bind_groups`); a frame that counts rays counts them all in
+        // one buffer (then with a barrier).
+        let beside = |i: usize| {
+            if self.counting {
+                scene
+            } else {
+                &self.scene.beside_bind_groups[i]
+            }
         };
         let first_walk = GatherRanges {
             bind_group: range_group,
@@ -905,7 +909,7 @@ impl Renderer {
                 },
                 Dispatches {
                     steps: &direct_steps,
-                    scene: beside,
+                    scene: beside(0),
                     pass: &direct_first,
                     ranges: Some(&first_walk),
                     group3: None,
@@ -994,50 +998,11 @@ impl Renderer {
             );
         }
 
-        // Scenes without mirrors have no mirrored hits: no stage. (Run side by side with
-        // the indirect stage, in one compute pass, the two took as long as one after the
-        // other: both fill the GPU. docs/PERFORMANCE.md, attempt 22.)
-        let mut mirror_e = &img.mirror_irradiance;
-        if let Some((mirror_bind, list_bind, _, _)) = &mirror_groups {
-            let list_pipeline = self.indirect.list_pipeline(iv);
-            let i = stage("mirror indirect");
-            rec.stage(
-                i,
-                "mirror indirect",
-                &[Dispatches {
-                    steps: &[(list_pipeline, [0, 0, 0])],
-                    scene,
-                    pass: mirror_bind,
-                    ranges: Some(&ranges),
-                    group3: Some(list_bind),
-                    indirect: Some(&img.mirror_args),
-                }],
-            );
-            // Interleaved mirrored hits: the discontinuity buffer over their own record.
-            if a.interleave.0 * a.interleave.1 > 1 {
-                let bind = self.filter.bind(
-                    device,
-                    &[
-                        &self.mirror_params,
-                        &img.mirror[0],
-                        &img.mirror[1],
-                        &img.mirror_irradiance,
-                        &img.mirror_filtered,
-                    ],
-                );
-                let i = stage("mirror discontinuity");
-                rec.dispatch(
-                    i,
-                    "mirror discontinuity",
-                    &self.filter.steps(Filter::Discontinuity, full, full),
-                    scene,
-                    &bind,
-                    None,
-                );
-                mirror_e = &img.mirror_filtered;
-            }
-        }
-
+        // The gathers: at the mirrored hits (scenes without mirrors have none: no
+        // dispatch), over the list the direct pass made, and at the pixels of the
+        // indirect term. Side by side in one stage (see `Recorder::side_by_side`): both
+        // end on a few slow warps, and each one's tail overlaps the other's work.
+        let list_steps = [(self.indirect.list_pipeline(iv), [0, 0, 0])];
         let indirect_bind = self.indirect.bind(
             device,
             &[
@@ -1050,48 +1015,132 @@ impl Renderer {
                 &img.irradiance,
             ],
         );
-        let i = stage("indirect");
-        rec.dispatch(
-            i,
-            "indirect",
-            &self.indirect.steps(
-                low.0,
-                low.1,
-                iv,
-                lanes_for(
-                    low.0 * low.1,
-                    a.interleave.0 * a.interleave.1 > 1,
-                    self.software,
-                ),
-                a.interleave,
+        let indirect_steps = self.indirect.steps(
+            low.0,
+            low.1,
+            iv,
+            lanes_for(
+                low.0 * low.1,
+                a.interleave.0 * a.interleave.1 > 1,
+                self.software,
             ),
-            scene,
-            &indirect_bind,
-            Some(&ranges),
+            a.interleave,
+        );
+        let mut gathers = vec![];
+        if let Some((mirror_bind, list_bind, _, _)) = &mirror_groups {
+            gathers.push((
+                "mirror indirect",
+                Dispatches {
+                    steps: &list_steps,
+                    scene,
+                    pass: mirror_bind,
+                    ranges: Some(&ranges),
+                    group3: Some(list_bind),
+                    indirect: Some(&img.mirror_args),
+                },
+            ));
+        }
+        gathers.push((
+            "indirect",
+            Dispatches {
+                steps: &indirect_steps,
+                scene: beside(1),
+                pass: &indirect_bind,
+                ranges: Some(&ranges),
+                group3: None,
+                indirect: None,
+            },
+        ));
+        let name = if gathers.len() > 1 {
+            "mirror indirect + indirect"
+        } else {
+            "indirect"
+        };
+        rec.side_by_side(
+            &mut stage,
+            name,
+            &[&img.position, &img.normal, &img.geometric],
+            gathers,
         );
 
-        // The filters, each from the last result to the next buffer.
-        let (filters, upsample) = filter_chain(a);
-        let mut e = &img.irradiance;
-        for filter in filters {
-            let out = match filter {
-                Filter::Discontinuity => &img.filtered_low,
-                Filter::Fused => &img.filtered,
-            };
-            let bind = self
-                .filter
-                .bind(device, &[&self.params, &img.position, &img.normal, e, out]);
-            let i = stage(filter.stage_name());
-            rec.dispatch(
-                i,
-                filter.stage_name(),
-                &self.filter.steps(filter, full, low),
-                scene,
-                &bind,
-                None,
-            );
-            e = out;
+        // The filter of the indirect term, beside the discontinuity buffer over the
+        // mirrored hits (interleaved frames with mirrors).
+        let (filter, upsample) = filter_chain(a);
+        let mirror_filter = self.has_mirrors && a.interleave.0 * a.interleave.1 > 1;
+        let mirror_e = if mirror_filter {
+            &img.mirror_filtered
+        } else {
+            &img.mirror_irradiance
+        };
+        let mirror_filter_bind = mirror_filter.then(|| {
+            self.filter.bind(
+                device,
+                &[
+                    &self.mirror_params,
+                    &img.mirror[0],
+                    &img.mirror[1],
+                    &img.mirror_irradiance,
+                    &img.mirror_filtered,
+                ],
+            )
+        });
+        let mirror_filter_steps = self.filter.steps(Filter::Discontinuity, full, full);
+        let mut filter_parts = vec![];
+        if let Some(bind) = &mirror_filter_bind {
+            filter_parts.push((
+                "mirror discontinuity",
+                Dispatches {
+                    steps: &mirror_filter_steps,
+                    scene,
+                    pass: bind,
+                    ranges: None,
+                    group3: None,
+                    indirect: None,
+                },
+            ));
         }
+        let filter_out = filter.map(|filter| match filter {
+            Filter::Discontinuity => &img.filtered_low,
+            Filter::Fused => &img.filtered,
+        });
+        let filter_bind = filter_out.map(|out| {
+            self.filter.bind(
+                device,
+                &[
+                    &self.params,
+                    &img.position,
+                    &img.normal,
+                    &img.irradiance,
+                    out,
+                ],
+            )
+        });
+        let filter_steps = filter.map(|filter| self.filter.steps(filter, full, low));
+        if let (Some(filter), Some(bind), Some(steps)) = (filter, &filter_bind, &filter_steps) {
+            filter_parts.push((
+                filter.stage_name(),
+                Dispatches {
+                    steps,
+                    scene: beside(2),
+                    pass: bind,
+                    ranges: None,
+                    group3: None,
+                    indirect: None,
+                },
+            ));
+        }
+        let name = match (filter_parts.len(), filter) {
+            (2, Some(Filter::Discontinuity)) => "mirror discontinuity + discontinuity",
+            (2, Some(Filter::Fused)) => "mirror discontinuity + fused filter",
+            _ => filter_parts.first().map_or("", |(name, _)| *name),
+        };
+        rec.side_by_side(
+            &mut stage,
+            name,
+            &[&img.irradiance, &img.mirror_irradiance],
+            filter_parts,
+        );
+        let e = filter_out.unwrap_or(&img.irradiance);
 
         let compose_bind = self.compose.bind(
             device,
@@ -1143,17 +1192,17 @@ pub fn low_resolution(settings: &RenderSettings) -> (u32, u32) {
     (settings.width.div_ceil(s), settings.height.div_ceil(s))
 }
 
-/// The filters an acceleration set-up runs on the indirect term, in order, and whether
-/// the compose pass then upsamples their result (joint bilateral upsampling, the second
-/// of the two passes of [`FilterMode::TwoPass`]).
-pub fn filter_chain(a: &Accelerations) -> (Vec<Filter>, bool) {
+/// The filter an acceleration set-up runs on the indirect term (if any), and whether the
+/// compose pass then upsamples its result (joint bilateral upsampling, the second of the
+/// two passes of [`FilterMode::TwoPass`]).
+pub fn filter_chain(a: &Accelerations) -> (Option<Filter>, bool) {
     let interleaved = a.interleave.0 * a.interleave.1 > 1;
     let downsampled = a.downsample > 1;
     match a.filter {
-        _ if !interleaved && !downsampled => (vec![], false),
-        FilterMode::Fused => (vec![Filter::Fused], false),
-        FilterMode::TwoPass if interleaved => (vec![Filter::Discontinuity], downsampled),
-        FilterMode::TwoPass => (vec![], downsampled),
+        _ if !interleaved && !downsampled => (None, false),
+        FilterMode::Fused => (Some(Filter::Fused), false),
+        FilterMode::TwoPass if interleaved => (Some(Filter::Discontinuity), downsampled),
+        FilterMode::TwoPass => (None, downsampled),
     }
 }
 

@@ -9,11 +9,13 @@ use igi_core::scene::Scene;
 pub struct SceneBuffers {
     pub layout: wgpu::BindGroupLayout,
     pub bind_group: wgpu::BindGroup,
-    /// The same scene with spare ray counters, for a pass that runs beside another one in
-    /// a frame that counts nothing (the direct pass beside VPL shooting): wgpu keeps two
-    /// dispatches that bind one read-write buffer apart by a barrier, even when neither
-    /// writes it.
-    pub beside_bind_group: wgpu::BindGroup,
+    /// The same scene with spare ray counters, one set per pass that runs beside another
+    /// one in a frame that counts nothing ([0]: the direct pass beside VPL shooting, [1]:
+    /// the indirect gather beside the mirror gather, [2]: the indirect term's filter beside
+    /// the mirror discontinuity buffer): wgpu puts a barrier before a dispatch that binds
+    /// read-write a buffer an earlier dispatch of the frame bound read-write, even when
+    /// neither writes it (`Recorder::side_by_side`).
+    pub beside_bind_groups: [wgpu::BindGroup; 3],
     pub light_count: u32,
     /// The point lights (binding 4), rewritten when the viewer moves a light.
     pub lights: wgpu::Buffer,
@@ -148,7 +150,11 @@ impl SceneBuffers {
         ];
         let bytes = buffers.iter().map(|b| b.size()).sum();
         let ray_counters = storage_buffer(ctx, "ray counters", &[0u8; 32])?;
-        let spare_counters = storage_buffer(ctx, "spare ray counters", &[0u8; 32])?;
+        let spare_counters = [
+            storage_buffer(ctx, "spare ray counters", &[0u8; 32])?,
+            storage_buffer(ctx, "spare ray counters", &[0u8; 32])?,
+            storage_buffer(ctx, "spare ray counters", &[0u8; 32])?,
+        ];
         let layout = Self::layout(&ctx.device);
         let group = |label: &str, counters: &wgpu::Buffer| {
             let entries: Vec<wgpu::BindGroupEntry> = buffers
@@ -167,12 +173,12 @@ impl SceneBuffers {
             })
         };
         let bind_group = group("scene", &ray_counters);
-        let beside_bind_group = group("scene (spare ray counters)", &spare_counters);
+        let beside_bind_groups = spare_counters.map(|c| group("scene (spare ray counters)", &c));
         let [_, _, _, _, lights_buffer] = buffers;
         Ok(SceneBuffers {
             layout,
             bind_group,
-            beside_bind_group,
+            beside_bind_groups,
             light_count: lights.len() as u32,
             lights: lights_buffer,
             ray_counters,

@@ -508,6 +508,49 @@ impl<'a> Recorder<'a> {
         }
     }
 
+    /// The dispatches of several passes that depend on none of each other, side by side
+    /// in one stage called `name` (each part in a stage of its own, under its own name,
+    /// with `IGI_SIDE_BY_SIDE=0`, for measurements). `stage` numbers the stages.
+    ///
+    /// wgpu puts a barrier before a dispatch when one of its buffers changes state, and
+    /// also when it binds read-write a buffer that an earlier dispatch of the frame bound
+    /// read-write (whether or not either writes it). A barrier waits for every dispatch
+    /// before it, so one before the second part would run the parts one after the other
+    /// (measured on the H200: docs/PERFORMANCE.md attempt 65). So the parts after the
+    /// first must bind only buffers that are either read-only in the state the frame
+    /// left them in, or made so here (`read_only`: put in the read-only storage state
+    /// before the stage, where a barrier is due anyway), or bound read-write for the first
+    /// time in the frame: their outputs, and spare ray counters
+    /// (`SceneBuffers::beside_bind_groups`).
+    pub(crate) fn side_by_side(
+        &mut self,
+        stage: &mut dyn FnMut(&'static str) -> u32,
+        name: &'static str,
+        read_only: &[&wgpu::Buffer],
+        parts: Vec<(&'static str, Dispatches)>,
+    ) {
+        let together = std::env::var("IGI_SIDE_BY_SIDE").as_deref() != Ok("0");
+        if together && parts.len() > 1 {
+            if let Some(cpass) = &mut self.pass {
+                cpass.transition_resources(
+                    read_only.iter().map(|&buffer| wgpu::BufferTransition {
+                        buffer,
+                        state: wgpu::BufferUses::STORAGE_READ_ONLY,
+                    }),
+                    std::iter::empty(),
+                );
+            }
+            let (_, parts): (Vec<_>, Vec<_>) = parts.into_iter().unzip();
+            let i = stage(name);
+            self.stage(i, name, &parts);
+        } else {
+            for (name, part) in parts {
+                let i = stage(name);
+                self.stage(i, name, &[part]);
+            }
+        }
+    }
+
     /// Stage `stage` with one pass's dispatches (see [`Dispatches`]).
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn dispatch(
