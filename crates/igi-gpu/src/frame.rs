@@ -11,7 +11,7 @@ use crate::passes::compose::ComposePass;
 use crate::passes::direct::{DirectBindings, DirectPass};
 use crate::passes::display::DisplayInputs;
 use crate::passes::filter::{Filter, FilterPass};
-use crate::passes::indirect::IndirectPass;
+use crate::passes::indirect::{list_pixels_per_group, IndirectPass};
 use crate::passes::vpl::VplPass;
 use crate::passes::{
     gather_range_layout, lanes_for, mirror_lanes, Dispatches, GatherRanges, Recorder,
@@ -27,10 +27,10 @@ use igi_core::settings::{
     Accelerations, FilterMode, GeometryBound, InterleavePattern, OutputBuffer, RenderSettings,
 };
 
-/// Most stages a frame can have (VPL shooting, direct, VPL list, mirror chains, mirror
-/// indirect, mirror discontinuity, indirect, two filters, compose), each with its
-/// timestamp pair.
-pub const MAX_STAGES: u32 = 10;
+/// Most stages a frame can have (VPL shooting + direct, VPL list, mirror chains, mirror
+/// indirect, indirect, mirror discontinuity, filter, compose, with `IGI_SIDE_BY_SIDE=0`),
+/// each with its timestamp pair.
+pub const MAX_STAGES: u32 = 8;
 
 /// Light paths of the pilot run that estimates VPLs per path.
 pub const PILOT_PATHS: u32 = 4096;
@@ -179,7 +179,12 @@ impl Renderer {
         // One pass over the triangles for both figures of the scene's size.
         let (lo, hi) = scene.bounds();
         let renderer = Renderer {
-            vpl: VplPass::new(device, layout),
+            vpl: VplPass::new(
+                device,
+                layout,
+                &range_layout,
+                list_pixels_per_group(mirror_lanes(software)),
+            ),
             direct: DirectPass::new(device, layout, &range_layout),
             indirect: IndirectPass::new(device, layout, &range_layout, mirror_lanes(software)),
             range_layout,
@@ -594,7 +599,7 @@ impl Renderer {
         Recorder::new(&mut encoder, &untimed, "vpl pilot").dispatch(
             0,
             "vpl pilot",
-            &self.vpl.steps(PILOT_PATHS),
+            &self.vpl.steps(PILOT_PATHS, false),
             &self.scene.bind_group,
             &bind,
             None,
@@ -853,7 +858,7 @@ impl Renderer {
             &self.vpl_header,
             &self.halton_perms.1,
         );
-        let [shoot, compact] = self.vpl.steps(paths);
+        let [shoot, compact] = self.vpl.steps(paths, self.has_mirrors);
         let direct_bind = |vpls: &wgpu::Buffer, header: &wgpu::Buffer| {
             self.direct.bind(
                 device,
@@ -918,9 +923,10 @@ impl Renderer {
             ],
         );
 
-        // The indirect pass over the mirror record (the mirror indirect stage below),
-        // gathering only at the pixels the direct pass listed; its bind groups, those of
-        // the list and that of the mirror chains' dispatch, in scenes with mirrors.
+        // The indirect pass over the mirror record (the mirror gather below), gathering
+        // only at the pixels the direct pass listed: its bind groups (its parameters and
+        // buffers, the list), and that of the lists and dispatch sizes for the VPL list
+        // stage, in scenes with mirrors.
         let mirror_groups = self.has_mirrors.then(|| {
             let bind = self.indirect.bind(
                 device,
@@ -934,49 +940,34 @@ impl Renderer {
                     &img.mirror_irradiance,
                 ],
             );
-            let (list, args) = self
-                .indirect
-                .bind_list(device, &img.mirror_list, &img.mirror_args);
-            let chain_args = self.direct.bind_args(device, &img.chain_args);
-            (bind, list, args, chain_args)
+            let list = self.indirect.bind_list(device, &img.mirror_list);
+            let sizes = self.vpl.bind_lists(
+                device,
+                &[
+                    &img.mirror_list,
+                    &img.mirror_args,
+                    &img.chain_list,
+                    &img.chain_args,
+                ],
+            );
+            (bind, list, sizes)
         });
         let one_range = GatherRanges {
             bind_group: range_group,
             first: 1,
             count: 1,
         };
-        let args_step = [self.indirect.args_step()];
-        let chain_args_step = [self.direct.args_step()];
+        // One dispatch: the compaction, which in scenes with mirrors also sizes the
+        // dispatches over the direct pass's lists (and resets them for the next frame).
         let compact_step = [compact];
-        let mut list_parts = vec![Dispatches {
+        let list_parts = [Dispatches {
             steps: &compact_step,
             scene,
             pass: &vpl_bind,
-            ranges: None,
-            group3: None,
+            ranges: mirror_groups.as_ref().map(|_| &one_range),
+            group3: mirror_groups.as_ref().map(|(_, _, sizes)| sizes),
             indirect: None,
         }];
-        if let Some((mirror_bind, _, args_bind, chain_args_bind)) = &mirror_groups {
-            // Sizes the mirror indirect dispatch from the list's length.
-            list_parts.push(Dispatches {
-                steps: &args_step,
-                scene,
-                pass: mirror_bind,
-                ranges: Some(&one_range),
-                group3: Some(args_bind),
-                indirect: None,
-            });
-            // Sizes the later walks of the direct pass from its list of chains (and
-            // resets the list, which the first walk fills in any scene with mirrors).
-            list_parts.push(Dispatches {
-                steps: &chain_args_step,
-                scene,
-                pass: &direct_first,
-                ranges: Some(&one_range),
-                group3: Some(chain_args_bind),
-                indirect: None,
-            });
-        }
         let i = stage("vpl list");
         rec.stage(i, "vpl list", &list_parts);
 
@@ -1027,7 +1018,7 @@ impl Renderer {
             a.interleave,
         );
         let mut gathers = vec![];
-        if let Some((mirror_bind, list_bind, _, _)) = &mirror_groups {
+        if let Some((mirror_bind, list_bind, _)) = &mirror_groups {
             gathers.push((
                 "mirror indirect",
                 Dispatches {

@@ -1,7 +1,7 @@
 //! Direct + specular at full resolution (paper section 4, second stage), writing the
 //! G-buffer of the primary hits. See `shaders/direct.wgsl`.
 
-use super::{bind, pass_layout, pipeline, GatherPipelines};
+use super::{bind, pass_layout, GatherPipelines};
 use crate::scene_buffers::{READ, UNIFORM, WRITE};
 
 /// Pixels per workgroup of the direct pass (`@workgroup_size` of direct.wgsl): one warp,
@@ -15,12 +15,6 @@ pub struct DirectPass {
     pipelines: GatherPipelines,
     /// The later walks over the listed chains (`chains_main`, dispatched indirectly).
     chains: GatherPipelines,
-    /// Bind group 3 of the step that sizes that dispatch: its workgroup counts (not bound
-    /// to the walks: a buffer read as indirect arguments may not be bound for storage in
-    /// the same dispatch).
-    args_layout: wgpu::BindGroupLayout,
-    /// Reads the list's length and writes the indirect dispatch (`chain_args_main`).
-    args: wgpu::ComputePipeline,
 }
 
 /// The buffers the direct pass reads and writes, in binding order after the parameters.
@@ -54,35 +48,16 @@ impl DirectPass {
                 WRITE, WRITE,
             ],
         );
-        let args_layout = pass_layout(device, "chain dispatch", &[WRITE]);
         let layouts = [scene_layout, &layout, range_layout];
         DirectPass {
             pipelines: GatherPipelines::new(device, "direct", "main", &layouts, &[]),
             chains: GatherPipelines::new(device, "direct", "chains_main", &layouts, &[]),
-            args: pipeline(
-                device,
-                "direct",
-                "chain_args_main",
-                &[scene_layout, &layout, range_layout, &args_layout],
-            ),
-            args_layout,
             layout,
         }
     }
 
-    /// Bind group 3 of the step that sizes the later walks' dispatch.
-    pub fn bind_args(&self, device: &wgpu::Device, args: &wgpu::Buffer) -> wgpu::BindGroup {
-        bind(device, "chain dispatch", &self.args_layout, &[args])
-    }
-
-    /// The one-thread step that sizes the later walks' dispatch from the list's length
-    /// (and resets the list for the next frame).
-    pub fn args_step(&self) -> (&wgpu::ComputePipeline, [u32; 3]) {
-        (&self.args, [1, 1, 1])
-    }
-
-    /// The later walks over the listed chains (dispatched indirectly, see
-    /// [`Self::args_step`]).
+    /// The later walks over the listed chains (dispatched indirectly, sized by the VPL
+    /// list stage: `VplPass::bind_lists`).
     pub fn chains_pipeline(&self, imperfect_visibility: bool) -> &wgpu::ComputePipeline {
         self.chains.get(imperfect_visibility)
     }

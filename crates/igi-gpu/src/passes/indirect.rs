@@ -5,22 +5,30 @@
 //! the paper gathers every VPL there and leaves that cost as future work).
 //! See `shaders/indirect.wgsl`.
 
-use super::{bind, pass_layout, pipeline_with_constants, GatherPipelines, LanePipelines};
+use super::{bind, pass_layout, GatherPipelines, LanePipelines};
 use crate::scene_buffers::{READ, UNIFORM, WRITE};
+
+/// Threads of a workgroup of the gather over the list of mirrored pixels (indirect.wgsl
+/// `LIST_GROUP`) with `lanes` lanes per pixel: 256, or 32 per lane where that is more, so
+/// that a warp always holds one lane of 32 pixels.
+pub fn list_group(lanes: u32) -> u32 {
+    256.max(32 * lanes)
+}
+
+/// Listed pixels per workgroup of that gather (its dispatch is sized by the VPL list
+/// stage, vpl.wgsl `MIRROR_LIST_PIXELS`).
+pub fn list_pixels_per_group(lanes: u32) -> u32 {
+    list_group(lanes) / lanes
+}
 
 pub struct IndirectPass {
     pub layout: wgpu::BindGroupLayout,
     pipelines: LanePipelines,
     /// Bind group 3 of the gather over the list of mirrored pixels: the list
-    /// (direct.wgsl's mirror_list); of the step that sizes its dispatch: the list and the
-    /// dispatch's workgroup counts (not in the gather's group: a buffer read as indirect
-    /// arguments may not be bound for storage in the same dispatch).
+    /// (direct.wgsl's mirror_list), read-only.
     list_layout: wgpu::BindGroupLayout,
-    args_layout: wgpu::BindGroupLayout,
     /// The gather over the listed pixels (`main_list`).
     list: GatherPipelines,
-    /// Reads the list's length and writes the indirect dispatch (`mirror_args_main`).
-    args: wgpu::ComputePipeline,
 }
 
 impl IndirectPass {
@@ -38,56 +46,31 @@ impl IndirectPass {
             "indirect",
             &[UNIFORM, READ, READ, READ, READ, READ, WRITE],
         );
-        let list_layout = pass_layout(device, "mirror list", &[WRITE]);
-        let args_layout = pass_layout(device, "mirror list and dispatch", &[WRITE, WRITE]);
+        let list_layout = pass_layout(device, "mirror list", &[READ]);
         let layouts = [scene_layout, &layout, range_layout, &list_layout];
-        let args_layouts = [scene_layout, &layout, range_layout, &args_layout];
-        let lanes = [("VPL_LANES", list_lanes as f64)];
+        let constants = [
+            ("VPL_LANES", list_lanes as f64),
+            ("LIST_GROUP", list_group(list_lanes) as f64),
+        ];
         IndirectPass {
             pipelines: LanePipelines::new(
                 device,
                 "indirect",
                 &[scene_layout, &layout, range_layout],
             ),
-            list: GatherPipelines::new(device, "indirect", "main_list", &layouts, &lanes),
-            args: pipeline_with_constants(
-                device,
-                "indirect",
-                "mirror_args_main",
-                &args_layouts,
-                &lanes,
-            ),
+            list: GatherPipelines::new(device, "indirect", "main_list", &layouts, &constants),
             list_layout,
-            args_layout,
             layout,
         }
     }
 
-    /// Bind group 3 of the list gather (the list) and of its sizing step (the list and
-    /// the dispatch arguments).
-    pub fn bind_list(
-        &self,
-        device: &wgpu::Device,
-        list: &wgpu::Buffer,
-        args: &wgpu::Buffer,
-    ) -> (wgpu::BindGroup, wgpu::BindGroup) {
-        (
-            bind(device, "mirror list", &self.list_layout, &[list]),
-            bind(
-                device,
-                "mirror list and dispatch",
-                &self.args_layout,
-                &[list, args],
-            ),
-        )
+    /// Bind group 3 of the list gather (the list).
+    pub fn bind_list(&self, device: &wgpu::Device, list: &wgpu::Buffer) -> wgpu::BindGroup {
+        bind(device, "mirror list", &self.list_layout, &[list])
     }
 
-    /// The one-thread step that sizes the list gather's dispatch.
-    pub fn args_step(&self) -> (&wgpu::ComputePipeline, [u32; 3]) {
-        (&self.args, [1, 1, 1])
-    }
-
-    /// The gather over the listed pixels (dispatched indirectly, see [`Self::args_step`]).
+    /// The gather over the listed pixels (dispatched indirectly, sized by the VPL list
+    /// stage: `VplPass::bind_lists`).
     pub fn list_pipeline(&self, imperfect_visibility: bool) -> &wgpu::ComputePipeline {
         self.list.get(imperfect_visibility)
     }

@@ -31,15 +31,15 @@
 @group(1) @binding(11) var<storage, read_write> mirror_weight: array<vec4<f32>>;
 // The pixels that have such a hit, for the mirror indirect stage to gather at only them,
 // in one bucket per interleaving subset (see mirror_bucket in gather.wgsl): [s] counts
-// the pixels appended to bucket s (reset by indirect.wgsl's mirror_args_main once it has
+// the pixels appended to bucket s (reset by vpl.wgsl's compact_and_size once it has
 // read them), [MAX_SUBSETS + s] is that stage's copy of the count, bucket s starts at
 // 2 MAX_SUBSETS + s mirror_bucket_size().
 @group(1) @binding(12) var<storage, read_write> mirror_list: array<atomic<u32>>;
 // The pixels whose chain has hits seen in a mirror seen in a mirror, for the later walks:
-// [0] counts those the first walk appended (reset by chain_args_main once it has read
-// it), [1] is the later walks' copy of the count, the pixels follow from [2] on. (A
-// dispatch over the whole image that skipped the others took 0.018 ms of the H200 in the
-// conference room, which has none: docs/PERFORMANCE.md attempt 50.)
+// [0] counts those the first walk appended (reset by vpl.wgsl's compact_and_size once it
+// has read it), [1] is the later walks' copy of the count, the pixels follow from [2] on.
+// (A dispatch over the whole image that skipped the others took 0.018 ms of the H200 in
+// the conference room, which has none: docs/PERFORMANCE.md attempt 50.)
 @group(1) @binding(13) var<storage, read_write> chain_list: array<atomic<u32>>;
 
 // The first walk: one thread per pixel, 8 x 4 pixels (one warp) per workgroup: 8 x 8 took
@@ -52,25 +52,6 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     shade(gid.x, gid.y);
 }
-
-// Workgroup counts of chains_main, for dispatch_workgroups_indirect.
-@group(3) @binding(0) var<storage, read_write> chain_args: array<u32>;
-
-// One thread: takes this frame's count of listed chains, resets the counter for the next
-// frame and sizes chains_main's dispatch.
-@compute @workgroup_size(1)
-fn chain_args_main() {
-    let n = atomicLoad(&chain_list[0]);
-    atomicStore(&chain_list[0], 0u);
-    atomicStore(&chain_list[1], n);
-    let size = dispatch_size((n + CHAIN_GROUP - 1u) / CHAIN_GROUP, 1u);
-    chain_args[0] = size.x;
-    chain_args[1] = size.y;
-    chain_args[2] = size.z;
-}
-
-// Listed pixels per workgroup of chains_main.
-const CHAIN_GROUP: u32 = 32u;
 
 // A later walk over the listed pixels, one thread each.
 @compute @workgroup_size(CHAIN_GROUP)

@@ -60,23 +60,6 @@ fn interleave_subset(x: u32, y: u32) -> u32 {
     return perm[local];
 }
 
-// Most interleaving subsets (frame.rs MAX_SUBSETS).
-const MAX_SUBSETS: u32 = 64u;
-
-// Largest workgroup count of one dispatch dimension.
-const MAX_GROUPS: u32 = 65535u;
-
-// The workgroup counts (x, y, z) of an indirect dispatch of `groups` workgroups in each
-// of `layers` z layers: x up to MAX_GROUPS, y as many rows of x as needed; nothing at all
-// when there are no workgroups.
-fn dispatch_size(groups: u32, layers: u32) -> vec3<u32> {
-    let x = min(groups, MAX_GROUPS);
-    if (x == 0u) {
-        return vec3<u32>(0u);
-    }
-    return vec3<u32>(x, (groups + x - 1u) / x, layers);
-}
-
 // Room for the pixels of one interleaving subset in the list of mirrored pixels
 // (direct.wgsl's mirror_list): every n x m tile of the full-resolution image, partial
 // ones at the edges included, holds one pixel of each subset.

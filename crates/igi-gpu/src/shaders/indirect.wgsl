@@ -93,33 +93,15 @@ fn main_coherent(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocat
 // whole image spent most of its workgroups on pixels with nothing to gather. The list
 // has one bucket per interleaving subset, so that the 32 pixels of a warp gather the
 // same VPLs in step, as in main_coherent.
-@group(3) @binding(0) var<storage, read_write> mirror_list: array<u32>;
-// Workgroups of main_list (x, y, z), for dispatch_workgroups_indirect.
-@group(3) @binding(1) var<storage, read_write> mirror_args: array<u32>;
+// Its counts were copied to [MAX_SUBSETS + s] by vpl.wgsl's compact_and_size, which
+// also sized this dispatch (LIST_GROUP / VPL_LANES pixels per workgroup); read-only here,
+// so that nothing keeps this gather from running beside the indirect gather (frame.rs).
+@group(3) @binding(0) var<storage, read> mirror_list: array<u32>;
 
 // Threads of a main_list workgroup: 256, or 32 per lane where that is more, so that a
 // warp always holds one lane of 32 pixels; it takes LIST_GROUP / VPL_LANES listed pixels.
-override LIST_GROUP: u32 = max(256u, 32u * VPL_LANES);
-
-// One thread: takes this frame's counts of mirrored pixels, resets the counters for the
-// next frame and sizes main_list's dispatch: one z layer per subset, as many workgroups
-// as the fullest bucket needs.
-@compute @workgroup_size(1)
-fn mirror_args_main() {
-    let subsets = params.interleave_n * params.interleave_m;
-    var most = 0u;
-    for (var s = 0u; s < subsets; s += 1u) {
-        let n = mirror_list[s];
-        mirror_list[s] = 0u;
-        mirror_list[MAX_SUBSETS + s] = n;
-        most = max(most, n);
-    }
-    let per_group = LIST_GROUP / VPL_LANES;
-    let size = dispatch_size((most + per_group - 1u) / per_group, subsets);
-    mirror_args[0] = size.x;
-    mirror_args[1] = size.y;
-    mirror_args[2] = size.z;
-}
+// Set by frame.rs (`passes::indirect::list_group`).
+override LIST_GROUP: u32 = 256u;
 
 // The gather over the listed pixels of bucket group.z, VPL_LANES threads per pixel, a
 // warp holding one lane of 32 pixels (as main_coherent): they trace to the same VPL at

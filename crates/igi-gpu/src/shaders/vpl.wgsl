@@ -5,7 +5,10 @@
 // stored VPLs. Path i is driven by the scrambled Halton sequence at index
 // halton_base + i: dimension 0 picks the light, 1-2 the emission direction, then 3 per
 // segment (direction u, v; continuation).
-// A second entry point compacts the per-path slots into a dense, deterministic VPL list.
+// A second entry point compacts the per-path slots into a dense, deterministic VPL list;
+// in scenes with mirrors (`compact_and_size`) it also sizes the dispatches over the lists
+// of pixels the direct pass made (one dispatch for the whole "vpl list" stage: each
+// dispatch of its own cost a barrier, docs/PERFORMANCE.md attempt 68).
 
 @group(1) @binding(1) var<storage, read_write> vpl_slots: array<Vpl>;
 @group(1) @binding(2) var<storage, read_write> vpls: array<Vpl>;
@@ -133,6 +136,49 @@ fn shoot(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups)
     }
 }
 
+// The lists of direct.wgsl (see there): the pixels with a mirrored hit, in one bucket
+// per interleaving subset, and the pixels whose chain the later walks follow; and the
+// workgroup counts of the dispatches over them (indirect.wgsl main_list, direct.wgsl
+// chains_main), for dispatch_workgroups_indirect.
+@group(3) @binding(0) var<storage, read_write> mirror_list: array<u32>;
+@group(3) @binding(1) var<storage, read_write> mirror_args: array<u32>;
+@group(3) @binding(2) var<storage, read_write> chain_list: array<u32>;
+@group(3) @binding(3) var<storage, read_write> chain_args: array<u32>;
+
+// Listed pixels per workgroup of the mirror gather (LIST_GROUP / VPL_LANES of
+// indirect.wgsl), set by frame.rs.
+override MIRROR_LIST_PIXELS: u32 = 32u;
+
+// Takes this frame's counts of mirrored pixels, resets the counters for the next frame
+// and sizes the mirror gather's dispatch: one z layer per subset, as many workgroups as
+// the fullest bucket needs.
+fn size_mirror_gather() {
+    let subsets = params.interleave_n * params.interleave_m;
+    var most = 0u;
+    for (var s = 0u; s < subsets; s += 1u) {
+        let n = mirror_list[s];
+        mirror_list[s] = 0u;
+        mirror_list[MAX_SUBSETS + s] = n;
+        most = max(most, n);
+    }
+    let size = dispatch_size((most + MIRROR_LIST_PIXELS - 1u) / MIRROR_LIST_PIXELS, subsets);
+    mirror_args[0] = size.x;
+    mirror_args[1] = size.y;
+    mirror_args[2] = size.z;
+}
+
+// Takes this frame's count of listed chains, resets the counter for the next frame and
+// sizes the later walks' dispatch.
+fn size_chain_walks() {
+    let n = chain_list[0];
+    chain_list[0] = 0u;
+    chain_list[1] = n;
+    let size = dispatch_size((n + CHAIN_GROUP - 1u) / CHAIN_GROUP, 1u);
+    chain_args[0] = size.x;
+    chain_args[1] = size.y;
+    chain_args[2] = size.z;
+}
+
 const COMPACT_GROUP: u32 = 256u;
 var<workgroup> chunk_counts: array<u32, 256>;
 
@@ -141,6 +187,23 @@ var<workgroup> chunk_counts: array<u32, 256>;
 // chunk. Slot order is kept, so the VPL list is the same on every run.
 @compute @workgroup_size(256)
 fn compact(@builtin(local_invocation_index) t: u32) {
+    compact_slots(t);
+}
+
+// `compact`, with two threads of other warps sizing the dispatches over the lists.
+@compute @workgroup_size(256)
+fn compact_and_size(@builtin(local_invocation_index) t: u32) {
+    if (t == 64u) {
+        size_mirror_gather();
+    }
+    if (t == 128u) {
+        size_chain_walks();
+    }
+    compact_slots(t);
+}
+
+// Thread t of the compaction (a workgroup of COMPACT_GROUP threads).
+fn compact_slots(t: u32) {
     let slots = params.path_count * params.bounces;
     let chunk = (slots + COMPACT_GROUP - 1u) / COMPACT_GROUP;
     let begin = min(t * chunk, slots);
