@@ -114,6 +114,12 @@ pub struct Renderer {
     /// nothing: binding the real ones (written by VPL shooting) would put a barrier
     /// between the two passes, which are meant to run side by side.
     no_vpls: (wgpu::Buffer, wgpu::Buffer),
+    /// What the direct pass's later walks (`chains_main`) bind where its first walk binds
+    /// the G-buffer, the mirror record and the mirror list, which only the first walk
+    /// writes: scratch buffers that no other pass binds, so that the later walks can run
+    /// beside the gathers that read those outputs (wgpu would put a barrier between a
+    /// dispatch that binds a buffer read-write and one that reads it).
+    chain_scratch: [wgpu::Buffer; 9],
     /// The scrambled Halton sequence's digit permutations, for the seed they were made for.
     halton_perms: (u32, wgpu::Buffer),
     /// Bind group 2 of the gathering passes: the VPL ranges of one frame.
@@ -211,6 +217,7 @@ impl Renderer {
                 storage(device, "no vpls", std::mem::size_of::<Vpl>() as u64),
                 storage(device, "no vpl header", 16),
             ),
+            chain_scratch: std::array::from_fn(|_| storage(device, "chain walk scratch", 16)),
             halton_perms: (0, permutation_buffer(ctx, 0)),
             images: None,
             vpl_buffers: None,
@@ -971,28 +978,34 @@ impl Renderer {
         let i = stage("vpl list");
         rec.stage(i, "vpl list", &list_parts);
 
-        // Hits seen in a mirror seen in a mirror gather their VPLs in later walks of the
-        // direct pass, over the chains its first walk listed.
-        if self.has_mirrors && settings.mirror_depth >= 2 {
-            let i = stage("mirror chains");
-            rec.stage(
-                i,
-                "mirror chains",
-                &[Dispatches {
-                    steps: &[(self.direct.chains_pipeline(iv), [0, 0, 0])],
-                    scene,
-                    pass: &direct_bind(&vb.vpls, &self.vpl_header),
-                    ranges: Some(&ranges),
-                    group3: None,
-                    indirect: Some(&img.chain_args),
-                }],
-            );
-        }
-
-        // The gathers: at the mirrored hits (scenes without mirrors have none: no
-        // dispatch), over the list the direct pass made, and at the pixels of the
-        // indirect term. Side by side in one stage (see `Recorder::side_by_side`): both
-        // end on a few slow warps, and each one's tail overlaps the other's work.
+        // The gathers, side by side in one stage (see `Recorder::side_by_side`): each
+        // ends on a few slow warps, and each one's tail overlaps the others' work. First
+        // the VPL light at hits seen in a mirror seen in a mirror: later walks of the
+        // direct pass over the chains its first walk listed, which write only its
+        // radiance (the first walk's other outputs are bound to scratch buffers, so that
+        // they share nothing the other gathers read). Then the gather at the mirrored
+        // hits (over the list the direct pass made) and the one at the pixels of the
+        // indirect term. Scenes without mirrors have only the last.
+        let chains_bind = (self.has_mirrors && settings.mirror_depth >= 2).then(|| {
+            let [s0, s1, s2, s3, s4, s5, s6, s7, s8] = &self.chain_scratch;
+            self.direct.bind(
+                device,
+                &self.params,
+                DirectBindings {
+                    vpls: &vb.vpls,
+                    vpl_header: &self.vpl_header,
+                    direct: &img.direct,
+                    position: s0,
+                    normal: s1,
+                    geometric: s2,
+                    albedo: s3,
+                    mirror: [s4, s5, s6, s7],
+                    mirror_list: s8,
+                    chain_list: &img.chain_list,
+                },
+            )
+        });
+        let chains_steps = [(self.direct.chains_pipeline(iv), [0, 0, 0])];
         let list_steps = [(self.indirect.list_pipeline(iv), [0, 0, 0])];
         let indirect_bind = self.indirect.bind(
             device,
@@ -1018,12 +1031,25 @@ impl Renderer {
             a.interleave,
         );
         let mut gathers = vec![];
+        if let Some(bind) = &chains_bind {
+            gathers.push((
+                "mirror chains",
+                Dispatches {
+                    steps: &chains_steps,
+                    scene,
+                    pass: bind,
+                    ranges: Some(&ranges),
+                    group3: None,
+                    indirect: Some(&img.chain_args),
+                },
+            ));
+        }
         if let Some((mirror_bind, list_bind, _)) = &mirror_groups {
             gathers.push((
                 "mirror indirect",
                 Dispatches {
                     steps: &list_steps,
-                    scene,
+                    scene: beside(1),
                     pass: mirror_bind,
                     ranges: Some(&ranges),
                     group3: Some(list_bind),
@@ -1035,28 +1061,79 @@ impl Renderer {
             "indirect",
             Dispatches {
                 steps: &indirect_steps,
-                scene: beside(1),
+                scene: beside(2),
                 pass: &indirect_bind,
                 ranges: Some(&ranges),
                 group3: None,
                 indirect: None,
             },
         ));
-        let name = if gathers.len() > 1 {
-            "mirror indirect + indirect"
-        } else {
-            "indirect"
+        let name = match gathers.len() {
+            3 => "mirror chains + mirror indirect + indirect",
+            2 => "mirror indirect + indirect",
+            _ => "indirect",
+        };
+        // What the gathers after the first read: the G-buffer, the mirror record and its
+        // list, and the mirror gather's workgroup counts.
+        let read = |buffer| wgpu::BufferTransition {
+            buffer,
+            state: wgpu::BufferUses::STORAGE_READ_ONLY,
         };
         rec.side_by_side(
             &mut stage,
             name,
-            &[&img.position, &img.normal, &img.geometric],
+            &[
+                read(&img.position),
+                read(&img.normal),
+                read(&img.geometric),
+                read(&img.mirror[0]),
+                read(&img.mirror[1]),
+                read(&img.mirror[2]),
+                read(&img.mirror_list),
+                wgpu::BufferTransition {
+                    buffer: &img.mirror_args,
+                    state: wgpu::BufferUses::INDIRECT,
+                },
+            ],
             gathers,
         );
 
-        // The filter of the indirect term, beside the discontinuity buffer over the
-        // mirrored hits (interleaved frames with mirrors).
+        // The filter of the indirect term, and beside it the discontinuity buffer over the
+        // mirrored hits (interleaved frames with mirrors): in this order the stage took
+        // 0.019 ms against 0.021 at 800 x 600, 0.038 against 0.045 at 1920 x 1080 on the
+        // H200 (docs/PERFORMANCE.md attempt 70).
         let (filter, upsample) = filter_chain(a);
+        let filter_out = filter.map(|filter| match filter {
+            Filter::Discontinuity => &img.filtered_low,
+            Filter::Fused => &img.filtered,
+        });
+        let filter_bind = filter_out.map(|out| {
+            self.filter.bind(
+                device,
+                &[
+                    &self.params,
+                    &img.position,
+                    &img.normal,
+                    &img.irradiance,
+                    out,
+                ],
+            )
+        });
+        let filter_steps = filter.map(|filter| self.filter.steps(filter, full, low));
+        let mut filter_parts = vec![];
+        if let (Some(filter), Some(bind), Some(steps)) = (filter, &filter_bind, &filter_steps) {
+            filter_parts.push((
+                filter.stage_name(),
+                Dispatches {
+                    steps,
+                    scene,
+                    pass: bind,
+                    ranges: None,
+                    group3: None,
+                    indirect: None,
+                },
+            ));
+        }
         let mirror_filter = self.has_mirrors && a.interleave.0 * a.interleave.1 > 1;
         let mirror_e = if mirror_filter {
             &img.mirror_filtered
@@ -1076,43 +1153,12 @@ impl Renderer {
             )
         });
         let mirror_filter_steps = self.filter.steps(Filter::Discontinuity, full, full);
-        let mut filter_parts = vec![];
         if let Some(bind) = &mirror_filter_bind {
             filter_parts.push((
                 "mirror discontinuity",
                 Dispatches {
                     steps: &mirror_filter_steps,
-                    scene,
-                    pass: bind,
-                    ranges: None,
-                    group3: None,
-                    indirect: None,
-                },
-            ));
-        }
-        let filter_out = filter.map(|filter| match filter {
-            Filter::Discontinuity => &img.filtered_low,
-            Filter::Fused => &img.filtered,
-        });
-        let filter_bind = filter_out.map(|out| {
-            self.filter.bind(
-                device,
-                &[
-                    &self.params,
-                    &img.position,
-                    &img.normal,
-                    &img.irradiance,
-                    out,
-                ],
-            )
-        });
-        let filter_steps = filter.map(|filter| self.filter.steps(filter, full, low));
-        if let (Some(filter), Some(bind), Some(steps)) = (filter, &filter_bind, &filter_steps) {
-            filter_parts.push((
-                filter.stage_name(),
-                Dispatches {
-                    steps,
-                    scene: beside(2),
+                    scene: beside(3),
                     pass: bind,
                     ranges: None,
                     group3: None,
@@ -1121,14 +1167,14 @@ impl Renderer {
             ));
         }
         let name = match (filter_parts.len(), filter) {
-            (2, Some(Filter::Discontinuity)) => "mirror discontinuity + discontinuity",
-            (2, Some(Filter::Fused)) => "mirror discontinuity + fused filter",
+            (2, Some(Filter::Discontinuity)) => "discontinuity + mirror discontinuity",
+            (2, Some(Filter::Fused)) => "fused filter + mirror discontinuity",
             _ => filter_parts.first().map_or("", |(name, _)| *name),
         };
         rec.side_by_side(
             &mut stage,
             name,
-            &[&img.irradiance, &img.mirror_irradiance],
+            &[read(&img.irradiance), read(&img.mirror_irradiance)],
             filter_parts,
         );
         let e = filter_out.unwrap_or(&img.irradiance);

@@ -10,12 +10,12 @@ pub struct SceneBuffers {
     pub layout: wgpu::BindGroupLayout,
     pub bind_group: wgpu::BindGroup,
     /// The same scene with spare ray counters, one set per pass that runs beside another
-    /// one in a frame that counts nothing ([0]: the direct pass beside VPL shooting, [1]:
-    /// the indirect gather beside the mirror gather, [2]: the indirect term's filter beside
-    /// the mirror discontinuity buffer): wgpu puts a barrier before a dispatch that binds
-    /// read-write a buffer an earlier dispatch of the frame bound read-write, even when
-    /// neither writes it (`Recorder::side_by_side`).
-    pub beside_bind_groups: [wgpu::BindGroup; 3],
+    /// one in a frame that counts nothing ([0]: the direct pass beside VPL shooting, [1]
+    /// and [2]: the mirror gather and the indirect gather beside the mirror chains' walks,
+    /// [3]: the mirror discontinuity buffer beside the indirect term's filter): wgpu puts
+    /// a barrier before a dispatch that binds read-write a buffer an earlier dispatch of
+    /// the frame bound read-write, even when neither writes it (`Recorder::side_by_side`).
+    pub beside_bind_groups: [wgpu::BindGroup; 4],
     pub light_count: u32,
     /// The point lights (binding 4), rewritten when the viewer moves a light.
     pub lights: wgpu::Buffer,
@@ -151,6 +151,7 @@ impl SceneBuffers {
         let bytes = buffers.iter().map(|b| b.size()).sum();
         let ray_counters = storage_buffer(ctx, "ray counters", &[0u8; 32])?;
         let spare_counters = [
+            storage_buffer(ctx, "spare ray counters", &[0u8; 32])?,
             storage_buffer(ctx, "spare ray counters", &[0u8; 32])?,
             storage_buffer(ctx, "spare ray counters", &[0u8; 32])?,
             storage_buffer(ctx, "spare ray counters", &[0u8; 32])?,

@@ -517,8 +517,8 @@ impl<'a> Recorder<'a> {
     /// read-write (whether or not either writes it). A barrier waits for every dispatch
     /// before it, so one before the second part would run the parts one after the other
     /// (measured on the H200: docs/PERFORMANCE.md attempt 65). So the parts after the
-    /// first must bind only buffers that are either read-only in the state the frame
-    /// left them in, or made so here (`read_only`: put in the read-only storage state
+    /// first must bind only buffers that are either read-only (or indirect arguments) in
+    /// the state the frame left them in, or put in that state here (`ready`: transitions
     /// before the stage, where a barrier is due anyway), or bound read-write for the first
     /// time in the frame: their outputs, and spare ray counters
     /// (`SceneBuffers::beside_bind_groups`).
@@ -526,16 +526,16 @@ impl<'a> Recorder<'a> {
         &mut self,
         stage: &mut dyn FnMut(&'static str) -> u32,
         name: &'static str,
-        read_only: &[&wgpu::Buffer],
+        ready: &[wgpu::BufferTransition<&wgpu::Buffer>],
         parts: Vec<(&'static str, Dispatches)>,
     ) {
         let together = std::env::var("IGI_SIDE_BY_SIDE").as_deref() != Ok("0");
         if together && parts.len() > 1 {
             if let Some(cpass) = &mut self.pass {
                 cpass.transition_resources(
-                    read_only.iter().map(|&buffer| wgpu::BufferTransition {
-                        buffer,
-                        state: wgpu::BufferUses::STORAGE_READ_ONLY,
+                    ready.iter().map(|t| wgpu::BufferTransition {
+                        buffer: t.buffer,
+                        state: t.state,
                     }),
                     std::iter::empty(),
                 );
