@@ -15,13 +15,21 @@ fn low_coordinate(p: u32) -> f32 {
     return (f32(p) - f32(params.downsample / 2u)) / s;
 }
 
+// Whether the primary ray of pixel q hit a surface, from the G-buffer's shading normal
+// alone: its w is the hit's distance, positive (traverse.wgsl takes hits at t > 0), and
+// the direct pass clears it to 0 every frame. (Reading the position's w as well cost
+// every tap of the upsampler a second scattered read.)
+fn has_surface(q: u32) -> bool {
+    return gbuf_normal[q].w > 0.0;
+}
+
 // Range weight of the upsampler between full-resolution pixel p and sample q.
 fn range_weight(p: u32, q: u32) -> f32 {
-    if (gbuf_position[q].w <= 0.0) {
+    let nq = gbuf_normal[q];
+    if (nq.w <= 0.0) {
         return 0.0;
     }
     let np = gbuf_normal[p];
-    let nq = gbuf_normal[q];
     var w = pow(max(dot(np.xyz, nq.xyz), 0.0), params.normal_power);
     if (params.upsample_depth != 0u) {
         let d = (np.w - nq.w) / (params.depth_threshold * np.w);
@@ -51,7 +59,7 @@ fn gather_sample(g: ptr<function, Gathered>, x: i32, y: i32, w: f32, d2: f32) {
     let value = low_irradiance(u32(y) * params.low_width + u32(x));
     (*g).sum += w * value;
     (*g).weight += w;
-    if (gbuf_position[q].w > 0.0 && d2 < (*g).nearest_d2) {
+    if (has_surface(q) && d2 < (*g).nearest_d2) {
         (*g).nearest_d2 = d2;
         (*g).nearest = value;
     }
