@@ -1,5 +1,10 @@
 //! GPU time per stage from timestamp queries (paper section 5 reports the share of each
-//! stage): every stage is its own compute pass with a begin/end timestamp pair.
+//! stage): a begin/end timestamp pair per stage, or, where the stages follow each other
+//! inside one compute pass, one timestamp between two stages, the end of one and the
+//! start of the next (each timestamp written cost the H200 about a microsecond of frame
+//! time: docs/PERFORMANCE.md attempt 73).
+
+use std::cell::Cell;
 
 use crate::context::{GpuContext, GpuError};
 
@@ -16,6 +21,8 @@ pub struct Profiler {
     capacity: u32,
     /// Whether timestamps can be written inside a compute pass (between its dispatches).
     inside_passes: bool,
+    /// Whether the last frame's stages were timed back to back (see [`Self::set_chained`]).
+    chained: Cell<bool>,
 }
 
 impl Profiler {
@@ -27,6 +34,7 @@ impl Profiler {
                 resolve: None,
                 capacity: stages,
                 inside_passes: true,
+                chained: Cell::new(false),
             };
         }
         let count = 2 * stages;
@@ -49,7 +57,16 @@ impl Profiler {
                 .device
                 .features()
                 .contains(wgpu::Features::TIMESTAMP_QUERY_INSIDE_PASSES),
+            chained: Cell::new(false),
         }
+    }
+
+    /// How the frame being recorded writes its timestamps: `true` when its stages follow
+    /// each other in one compute pass and only stage 0 writes a start (index 0), every
+    /// stage i its end (index 2 i + 1), which is also stage i + 1's start; `false` for a
+    /// begin/end pair per stage. [`Self::read`] reads them the same way.
+    pub fn set_chained(&self, chained: bool) {
+        self.chained.set(chained);
     }
 
     /// Whether stages can share one compute pass and still be timed one by one (also
@@ -111,12 +128,19 @@ impl Profiler {
         let ms = |from: u64, to: u64| {
             to.saturating_sub(from) as f64 * ctx.queue.get_timestamp_period() as f64 * 1e-6
         };
+        let start = |i: usize| {
+            if self.chained.get() && i > 0 {
+                ticks[2 * i - 1]
+            } else {
+                ticks[2 * i]
+            }
+        };
         let stages = names
             .iter()
             .enumerate()
             .map(|(i, &name)| StageTime {
                 name,
-                ms: ms(ticks[2 * i], ticks[2 * i + 1]),
+                ms: ms(start(i), ticks[2 * i + 1]),
             })
             .collect();
         let span = ms(ticks[0], ticks[2 * names.len() - 1]);
@@ -132,6 +156,7 @@ impl Profiler {
             resolve: None,
             capacity: u32::MAX / 2,
             inside_passes: true,
+            chained: Cell::new(false),
         }
     }
 }

@@ -457,8 +457,9 @@ fn record(cpass: &mut wgpu::ComputePass, parts: &[Dispatches]) {
     }
 }
 
-/// Where a frame's stages are recorded: all in one compute pass, with each stage's
-/// timestamp pair written inside it, where the device can (or where nothing is timed),
+/// Where a frame's stages are recorded: all in one compute pass, with the stages'
+/// timestamps written inside it (one between two stages: `Profiler::set_chained`), where
+/// the device can (or where nothing is timed),
 /// else one compute pass per stage. wgpu turns every compute pass into command buffers
 /// of its own, and on the H200 each boundary cost a few microseconds of idle GPU
 /// (docs/PERFORMANCE.md, attempt 25); inside one pass wgpu still puts a barrier before
@@ -479,6 +480,7 @@ impl<'a> Recorder<'a> {
     ) -> Recorder<'a> {
         let one_pass = profiler.writes_inside_passes()
             && std::env::var("IGI_STAGE_PASSES").as_deref() != Ok("1");
+        profiler.set_chained(one_pass);
         let pass = one_pass.then(|| {
             encoder
                 .begin_compute_pass(&wgpu::ComputePassDescriptor {
@@ -498,7 +500,10 @@ impl<'a> Recorder<'a> {
     pub(crate) fn stage(&mut self, stage: u32, label: &str, parts: &[Dispatches]) {
         match &mut self.pass {
             Some(cpass) => {
-                self.profiler.write_inside(cpass, 2 * stage);
+                // Stages follow each other: one's end is the next one's start.
+                if stage == 0 {
+                    self.profiler.write_inside(cpass, 0);
+                }
                 cpass.push_debug_group(label);
                 record(cpass, parts);
                 cpass.pop_debug_group();
