@@ -590,6 +590,25 @@ pub fn write_charts(results: &BenchResults, dir: &Path) -> Result<Vec<String>> {
 }
 
 const LEGEND_WIDTH: u32 = 210;
+
+/// The legend's width for entries named `names`: at least [`LEGEND_WIDTH`], and room for
+/// the longest name (13-pixel sans-serif, at most 8 pixels a character, after the
+/// 36-pixel swatch), so that long stage names ("mirror chains + mirror indirect +
+/// indirect") are not cut off.
+fn legend_width<'a>(names: impl IntoIterator<Item = &'a str>) -> u32 {
+    let longest = names
+        .into_iter()
+        .map(|n| n.chars().count())
+        .max()
+        .unwrap_or(0);
+    LEGEND_WIDTH.max(36 + 8 * longest as u32 + 12)
+}
+
+/// The stage chart's legend width (its stages and the frame line).
+fn stages_legend_width(sc: &SceneRuns) -> u32 {
+    let names = stage_names(sc.runs.iter().copied());
+    legend_width(names.iter().map(String::as_str).chain(["frame (median)"]))
+}
 const BAR_PITCH: u32 = 64;
 
 /// Bars of the stage chart: (x position, set-up index, run); set-ups are separated by a
@@ -611,7 +630,10 @@ fn bars<'a>(sc: &SceneRuns<'a>) -> Vec<(f64, usize, &'a BenchRun)> {
 
 fn stages_chart_size(sc: &SceneRuns) -> (u32, u32) {
     let slots = bars(sc).len() as u32 + sc.setups.len() as u32;
-    ((slots * BAR_PITCH + 120 + LEGEND_WIDTH).max(760), 560)
+    (
+        (slots * BAR_PITCH + 120 + stages_legend_width(sc)).max(760),
+        560,
+    )
 }
 
 /// Text centred on a point, `size` pixels high.
@@ -659,17 +681,22 @@ type Areas<DB> = (DrawingArea<DB, Shift>, DrawingArea<DB, Shift>);
 fn titled<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     title: String,
+    legend_width: u32,
 ) -> Result<Areas<DB>, String> {
     root.fill(&WHITE).map_err(de)?;
     let (w, _h) = root.dim_in_pixel();
     let (top, body) = root.split_vertically(44);
     top.draw(&Text::new(title, (w as i32 / 2, 12), centred(20)))
         .map_err(de)?;
-    Ok(body.split_horizontally(w - LEGEND_WIDTH))
+    Ok(body.split_horizontally(w.saturating_sub(legend_width)))
 }
 
 fn draw_stages<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, sc: &SceneRuns) -> DrawResult {
-    let (plot, legend) = titled(root, format!("{}: GPU time per stage (medians)", sc.name))?;
+    let (plot, legend) = titled(
+        root,
+        format!("{}: GPU time per stage (medians)", sc.name),
+        stages_legend_width(sc),
+    )?;
 
     let bars = bars(sc);
     let top = bars
@@ -827,7 +854,16 @@ fn decades(values: impl Iterator<Item = f64>) -> (f64, f64) {
 
 /// relMSE (log axis) and FLIP (linear axis) against the median frame time.
 fn draw_errors<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, sc: &SceneRuns) -> DrawResult {
-    let (plots, legend) = titled(root, format!("{}: image error against frame time", sc.name))?;
+    let (plots, legend) = titled(
+        root,
+        format!("{}: image error against frame time", sc.name),
+        legend_width(
+            sc.setups
+                .iter()
+                .map(String::as_str)
+                .chain(["Set-ups (points: VPLs)"]),
+        ),
+    )?;
     let panels = plots.split_evenly((1, 2));
 
     let mut mse: Vec<ErrorPoint> = Vec::new();
@@ -1228,5 +1264,25 @@ mod tests {
         assert_eq!(file_stem(".."), "_..");
         assert_eq!(code("a`b"), "``a`b``");
         assert_eq!(cell("a|b"), "a\\|b");
+    }
+
+    #[test]
+    fn long_stage_names_widen_the_legend() {
+        let mut results = sample();
+        let short = SceneRuns::new(&results, "cornell-box");
+        let (short_width, _) = stages_chart_size(&short);
+        assert_eq!(stages_legend_width(&short), LEGEND_WIDTH);
+        let long = "mirror chains + mirror indirect + indirect";
+        for run in &mut results.runs {
+            run.stages[0].name = long.into();
+        }
+        let wide = SceneRuns::new(&results, "cornell-box");
+        let width = stages_legend_width(&wide);
+        assert!(width >= 36 + 8 * long.len() as u32, "{width}");
+        let (wide_width, _) = stages_chart_size(&wide);
+        assert!(
+            wide_width > short_width && wide_width >= width + 120,
+            "{wide_width}"
+        );
     }
 }
