@@ -1,9 +1,9 @@
 //! The frame (paper section 4): [`Renderer::encode_frame`] lists its passes in order —
-//! VPL shooting beside direct + specular, the VPL list, [the mirror chains], [mirror
-//! indirect beside] indirect diffuse, [the mirror discontinuity buffer beside] [its
-//! filter], compose — each stage with its own timestamp pair (passes side by side share
-//! one). The renderer owns the scene on the GPU, the passes and the frame's buffers;
-//! nothing is read back inside a frame.
+//! VPL shooting beside direct + specular, the VPL list, [the mirror chains' walks and the
+//! mirror indirect gather beside] the indirect diffuse gather, [its filter, beside the
+//! mirror discontinuity buffer], compose — each stage timed by GPU timestamps (passes
+//! side by side share their stage's). The renderer owns the scene on the GPU, the passes
+//! and the frame's buffers; nothing is read back inside a frame.
 
 use crate::context::{GpuContext, GpuError, SMALLER_FRAME};
 use crate::layout::{FrameParams, Vpl};
@@ -28,7 +28,7 @@ use igi_core::settings::{
 };
 
 /// Most stages a frame can have (VPL shooting + direct, VPL list, mirror chains, mirror
-/// indirect, indirect, mirror discontinuity, filter, compose, with `IGI_SIDE_BY_SIDE=0`),
+/// indirect, indirect, filter, mirror discontinuity, compose, with `IGI_SIDE_BY_SIDE=0`),
 /// each with its timestamp pair.
 pub const MAX_STAGES: u32 = 8;
 

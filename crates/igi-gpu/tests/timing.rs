@@ -39,7 +39,10 @@ fn chained_stage_times_add_up_to_the_frame() {
             frame.stages
         );
         let sum: f64 = frame.stages.iter().map(|s| s.ms).sum();
-        eprintln!("{setup}: {} stages, {sum} ms of {frame_ms} ms", frame.stages.len());
+        eprintln!(
+            "{setup}: {} stages, {sum} ms of {frame_ms} ms",
+            frame.stages.len()
+        );
         assert!(
             (sum - frame_ms).abs() <= 1e-9 * frame_ms.max(1.0),
             "{setup}: stages add up to {sum} ms, the frame took {frame_ms} ms"
