@@ -1,8 +1,9 @@
 //! GPU time per stage from timestamp queries (paper section 5 reports the share of each
 //! stage): a begin/end timestamp pair per stage, or, where the stages follow each other
 //! inside one compute pass, one timestamp between two stages, the end of one and the
-//! start of the next (each timestamp written cost the H200 about a microsecond of frame
-//! time: docs/PERFORMANCE.md attempt 73).
+//! start of the next, so that the stage times add up to the frame time (what falls
+//! between two stages, the barrier and the start of the next dispatch, counts for the
+//! next: docs/PERFORMANCE.md attempt 73).
 
 use std::cell::Cell;
 

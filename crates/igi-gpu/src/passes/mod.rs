@@ -459,8 +459,8 @@ fn record(cpass: &mut wgpu::ComputePass, parts: &[Dispatches]) {
 
 /// Where a frame's stages are recorded: all in one compute pass, with the stages'
 /// timestamps written inside it (one between two stages: `Profiler::set_chained`), where
-/// the device can (or where nothing is timed),
-/// else one compute pass per stage. wgpu turns every compute pass into command buffers
+/// the device can (or where nothing is timed), else one compute pass per stage, with a
+/// timestamp pair each. wgpu turns every compute pass into command buffers
 /// of its own, and on the H200 each boundary cost a few microseconds of idle GPU
 /// (docs/PERFORMANCE.md, attempt 25); inside one pass wgpu still puts a barrier before
 /// every dispatch that needs one. `IGI_STAGE_PASSES=1` forces a pass per stage, for
