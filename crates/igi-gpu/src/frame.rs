@@ -866,29 +866,29 @@ impl Renderer {
             &self.halton_perms.1,
         );
         let [shoot, compact] = self.vpl.steps(paths, self.has_mirrors);
-        let direct_bind = |vpls: &wgpu::Buffer, header: &wgpu::Buffer| {
-            self.direct.bind(
-                device,
-                &self.params,
-                DirectBindings {
-                    vpls,
-                    vpl_header: header,
-                    direct: &img.direct,
-                    position: &img.position,
-                    normal: &img.normal,
-                    geometric: &img.geometric,
-                    albedo: &img.albedo,
-                    mirror: [
-                        &img.mirror[0],
-                        &img.mirror[1],
-                        &img.mirror[2],
-                        &img.mirror[3],
-                    ],
-                    mirror_list: &img.mirror_list,
-                    chain_list: &img.chain_list,
-                },
-            )
-        };
+        // The direct pass's first walk gathers no VPLs: an empty list (the one shooting
+        // writes would keep the two passes apart).
+        let direct_first = self.direct.bind(
+            device,
+            &self.params,
+            DirectBindings {
+                vpls: &self.no_vpls.0,
+                vpl_header: &self.no_vpls.1,
+                direct: &img.direct,
+                position: &img.position,
+                normal: &img.normal,
+                geometric: &img.geometric,
+                albedo: &img.albedo,
+                mirror: [
+                    &img.mirror[0],
+                    &img.mirror[1],
+                    &img.mirror[2],
+                    &img.mirror[3],
+                ],
+                mirror_list: &img.mirror_list,
+                chain_list: &img.chain_list,
+            },
+        );
         // Spare ray counters for the dispatches that run beside an earlier one (see
         // `SceneBuffers::beside_bind_groups`); a frame that counts rays counts them all in
         // one buffer (then with a barrier).
@@ -904,7 +904,6 @@ impl Renderer {
             first: 0,
             count: 1,
         };
-        let direct_first = direct_bind(&self.no_vpls.0, &self.no_vpls.1);
         let direct_steps = self.direct.steps(full.0, full.1, iv);
         let i = stage("vpl shooting + direct");
         rec.stage(
@@ -1103,12 +1102,13 @@ impl Renderer {
         // 0.019 ms against 0.021 at 800 x 600, 0.038 against 0.045 at 1920 x 1080 on the
         // H200 (docs/PERFORMANCE.md attempt 70).
         let (filter, upsample) = filter_chain(a);
-        let filter_out = filter.map(|filter| match filter {
-            Filter::Discontinuity => &img.filtered_low,
-            Filter::Fused => &img.filtered,
-        });
-        let filter_bind = filter_out.map(|out| {
-            self.filter.bind(
+        // The filter's output, bind group and dispatch.
+        let filter_pass = filter.map(|filter| {
+            let out = match filter {
+                Filter::Discontinuity => &img.filtered_low,
+                Filter::Fused => &img.filtered,
+            };
+            let bind = self.filter.bind(
                 device,
                 &[
                     &self.params,
@@ -1117,11 +1117,11 @@ impl Renderer {
                     &img.irradiance,
                     out,
                 ],
-            )
+            );
+            (filter, out, bind, self.filter.steps(filter, full, low))
         });
-        let filter_steps = filter.map(|filter| self.filter.steps(filter, full, low));
         let mut filter_parts = vec![];
-        if let (Some(filter), Some(bind), Some(steps)) = (filter, &filter_bind, &filter_steps) {
+        if let Some((filter, _, bind, steps)) = &filter_pass {
             filter_parts.push((
                 filter.stage_name(),
                 Dispatches {
@@ -1177,7 +1177,9 @@ impl Renderer {
             &[read(&img.irradiance), read(&img.mirror_irradiance)],
             filter_parts,
         );
-        let e = filter_out.unwrap_or(&img.irradiance);
+        let e = filter_pass
+            .as_ref()
+            .map_or(&img.irradiance, |(_, out, _, _)| *out);
 
         let compose_bind = self.compose.bind(
             device,

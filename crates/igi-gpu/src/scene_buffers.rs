@@ -15,7 +15,7 @@ pub struct SceneBuffers {
     /// [3]: the mirror discontinuity buffer beside the indirect term's filter): wgpu puts
     /// a barrier before a dispatch that binds read-write a buffer an earlier dispatch of
     /// the frame bound read-write, even when neither writes it (`Recorder::side_by_side`).
-    pub beside_bind_groups: [wgpu::BindGroup; 4],
+    pub beside_bind_groups: [wgpu::BindGroup; SPARE_COUNTERS],
     pub light_count: u32,
     /// The point lights (binding 4), rewritten when the viewer moves a light.
     pub lights: wgpu::Buffer,
@@ -24,6 +24,9 @@ pub struct SceneBuffers {
     /// Bytes held on the GPU by the scene.
     pub bytes: u64,
 }
+
+/// Sets of spare ray counters (see [`SceneBuffers::beside_bind_groups`]).
+pub const SPARE_COUNTERS: usize = 4;
 
 /// A bind group layout entry for a compute-stage storage or uniform buffer.
 pub fn buffer_entry(binding: u32, ty: wgpu::BufferBindingType) -> wgpu::BindGroupLayoutEntry {
@@ -150,12 +153,10 @@ impl SceneBuffers {
         ];
         let bytes = buffers.iter().map(|b| b.size()).sum();
         let ray_counters = storage_buffer(ctx, "ray counters", &[0u8; 32])?;
-        let spare_counters = [
-            storage_buffer(ctx, "spare ray counters", &[0u8; 32])?,
-            storage_buffer(ctx, "spare ray counters", &[0u8; 32])?,
-            storage_buffer(ctx, "spare ray counters", &[0u8; 32])?,
-            storage_buffer(ctx, "spare ray counters", &[0u8; 32])?,
-        ];
+        let mut spare_counters = Vec::new();
+        for _ in 0..SPARE_COUNTERS {
+            spare_counters.push(storage_buffer(ctx, "spare ray counters", &[0u8; 32])?);
+        }
         let layout = Self::layout(&ctx.device);
         let group = |label: &str, counters: &wgpu::Buffer| {
             let entries: Vec<wgpu::BindGroupEntry> = buffers
@@ -174,7 +175,8 @@ impl SceneBuffers {
             })
         };
         let bind_group = group("scene", &ray_counters);
-        let beside_bind_groups = spare_counters.map(|c| group("scene (spare ray counters)", &c));
+        let beside_bind_groups =
+            std::array::from_fn(|i| group("scene (spare ray counters)", &spare_counters[i]));
         let [_, _, _, _, lights_buffer] = buffers;
         Ok(SceneBuffers {
             layout,
