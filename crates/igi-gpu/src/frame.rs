@@ -8,10 +8,10 @@
 use crate::context::{GpuContext, GpuError, SMALLER_FRAME};
 use crate::layout::{FrameParams, Vpl};
 use crate::passes::compose::ComposePass;
-use crate::passes::direct::{DirectBindings, DirectPass};
+use crate::passes::direct::{DirectBindings, DirectPass, CHAIN_WORKGROUPS};
 use crate::passes::display::DisplayInputs;
 use crate::passes::filter::{Filter, FilterPass};
-use crate::passes::indirect::{list_pixels_per_group, IndirectPass};
+use crate::passes::indirect::{IndirectPass, LIST_WORKGROUPS};
 use crate::passes::vpl::VplPass;
 use crate::passes::{
     gather_range_layout, lanes_for, mirror_lanes, Dispatches, GatherRanges, Recorder,
@@ -71,16 +71,12 @@ struct ImageBuffers {
     /// the discontinuity buffer over the mirrored hits (interleaved frames).
     mirror_irradiance: wgpu::Buffer,
     mirror_filtered: wgpu::Buffer,
-    /// The pixels with a mirrored hit (direct.wgsl's mirror_list: two counters per
-    /// interleaving subset, then a bucket of pixels per subset), and the workgroup counts
-    /// of the mirror indirect stage's dispatch.
+    /// The pixels with a mirrored hit (direct.wgsl's mirror_list: a counter per
+    /// interleaving subset, then a bucket of pixels per subset).
     mirror_list: wgpu::Buffer,
-    mirror_args: wgpu::Buffer,
     /// The pixels whose mirror chain the direct pass's later walks follow (direct.wgsl's
-    /// chain_list: two counters, then the pixels), and the workgroup counts of that
-    /// dispatch.
+    /// chain_list: a counter, then the pixels).
     chain_list: wgpu::Buffer,
-    chain_args: wgpu::Buffer,
     /// E at the indirect resolution, as the indirect pass leaves it.
     irradiance: wgpu::Buffer,
     /// After the discontinuity buffer (indirect resolution).
@@ -120,6 +116,11 @@ pub struct Renderer {
     /// beside the gathers that read those outputs (wgpu would put a barrier between a
     /// dispatch that binds a buffer read-write and one that reads it).
     chain_scratch: [wgpu::Buffer; 9],
+    /// The most workgroups of the mirror gather and of the direct pass's later walks,
+    /// which stride over lists whose lengths only the GPU knows
+    /// ([`crate::passes::indirect::LIST_WORKGROUPS`],
+    /// [`crate::passes::direct::CHAIN_WORKGROUPS`]).
+    list_grids: (u32, u32),
     /// The scrambled Halton sequence's digit permutations, for the seed they were made for.
     halton_perms: (u32, wgpu::Buffer),
     /// Bind group 2 of the gathering passes: the VPL ranges of one frame.
@@ -185,12 +186,7 @@ impl Renderer {
         // One pass over the triangles for both figures of the scene's size.
         let (lo, hi) = scene.bounds();
         let renderer = Renderer {
-            vpl: VplPass::new(
-                device,
-                layout,
-                &range_layout,
-                list_pixels_per_group(mirror_lanes(software)),
-            ),
+            vpl: VplPass::new(device, layout),
             direct: DirectPass::new(device, layout, &range_layout),
             indirect: IndirectPass::new(device, layout, &range_layout, mirror_lanes(software)),
             range_layout,
@@ -218,6 +214,7 @@ impl Renderer {
                 storage(device, "no vpl header", 16),
             ),
             chain_scratch: std::array::from_fn(|_| storage(device, "chain walk scratch", 16)),
+            list_grids: (LIST_WORKGROUPS, CHAIN_WORKGROUPS),
             halton_perms: (0, permutation_buffer(ctx, 0)),
             images: None,
             vpl_buffers: None,
@@ -233,6 +230,14 @@ impl Renderer {
         };
         ctx.check()?;
         Ok(renderer)
+    }
+
+    /// The most workgroups of the mirror gather and of the direct pass's later walks
+    /// from the next frame on (at least one per bucket): fewer than the lists need make
+    /// each workgroup take several parts of its list, which is what a larger image does
+    /// with the defaults; for tests of that path and for measurements.
+    pub fn set_list_grids(&mut self, mirror_gather: u32, chain_walks: u32) {
+        self.list_grids = (mirror_gather, chain_walks);
     }
 
     /// Look through `camera` from the next frame on.
@@ -299,6 +304,30 @@ impl Renderer {
         Ok(header[0])
     }
 
+    /// The lengths of the direct pass's lists in the last frame (waits for it): the
+    /// counts of the mirrored-pixel buckets, then the count of listed chains.
+    pub fn list_counters(&self, ctx: &GpuContext) -> Result<Vec<u32>, GpuError> {
+        let Some(images) = self.images.as_ref() else {
+            return Err(GpuError::Device("no frame rendered yet".into()));
+        };
+        let mirror: Vec<u32> = ctx.read_buffer(&images.mirror_list)?;
+        let chain: Vec<u32> = ctx.read_buffer(&images.chain_list)?;
+        let mut counters = mirror[..MAX_SUBSETS as usize].to_vec();
+        counters.push(chain[0]);
+        Ok(counters)
+    }
+
+    /// The weight record of the last frame's mirrored hits (waits for it): per pixel the
+    /// weight of the first diffuse hit of its mirror chain, w = 1 where there is one.
+    pub fn mirror_weights(&self, ctx: &GpuContext) -> Result<Vec<[f32; 4]>, GpuError> {
+        let Some(images) = self.images.as_ref() else {
+            return Err(GpuError::Device("no frame rendered yet".into()));
+        };
+        let mut weights: Vec<[f32; 4]> = ctx.read_buffer(&images.mirror[3])?;
+        weights.truncate(images.width as usize * images.height as usize);
+        Ok(weights)
+    }
+
     /// Bytes held on the GPU by the scene.
     pub fn scene_bytes(&self) -> u64 {
         self.scene.bytes
@@ -324,9 +353,7 @@ impl Renderer {
                 &b.mirror_filtered,
                 &b.color,
                 &b.mirror_list,
-                &b.mirror_args,
                 &b.chain_list,
-                &b.chain_args,
             ]
             .iter()
             .map(|b| b.size())
@@ -367,21 +394,13 @@ impl Renderer {
         }
         self.images = None;
         let size = width as u64 * height as u64 * 16;
-        // Two counters per subset, then one bucket per subset (direct.wgsl's mirror_list):
+        // A counter per subset, then one bucket per subset (direct.wgsl's mirror_list):
         // n x m buckets of ceil(w / n) ceil(h / m) pixels, at most (w + 63) (h + 63).
-        let list_size = (2 * MAX_SUBSETS as u64
+        let list_size = (MAX_SUBSETS as u64
             + (width as u64 + MAX_SUBSETS as u64 - 1) * (height as u64 + MAX_SUBSETS as u64 - 1))
             * 4;
-        let chain_size = (2 + width as u64 * height as u64) * 4;
+        let chain_size = (1 + width as u64 * height as u64) * 4;
         let device = &ctx.device;
-        let dispatch_args = |label| {
-            device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(label),
-                size: 16,
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT,
-                mapped_at_creation: false,
-            })
-        };
         let images = ctx.allocate(
             || format!("the {IMAGE_BUFFERS} frame buffers of a {width}x{height} image"),
             IMAGE_BUFFERS as u64 * size.max(16) + list_size + chain_size,
@@ -407,9 +426,7 @@ impl Renderer {
                 filtered: storage(device, "irradiance full resolution", size),
                 color: storage(device, "color", size),
                 mirror_list: storage(device, "mirror list", list_size),
-                mirror_args: dispatch_args("mirror indirect dispatch"),
                 chain_list: storage(device, "mirror chain list", chain_size),
-                chain_args: dispatch_args("mirror chains dispatch"),
             },
         )?;
         self.images = Some(images);
@@ -603,10 +620,12 @@ impl Renderer {
         );
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
         let untimed = Profiler::disabled();
+        let steps = self.vpl.steps(PILOT_PATHS);
+        let steps: Vec<_> = std::iter::once(steps.shoot).chain(steps.compact).collect();
         Recorder::new(&mut encoder, &untimed, "vpl pilot").dispatch(
             0,
             "vpl pilot",
-            &self.vpl.steps(PILOT_PATHS, false),
+            &steps,
             &self.scene.bind_group,
             &bind,
             None,
@@ -724,6 +743,9 @@ impl Renderer {
             ctx.queue
                 .write_buffer(&self.mirror_params, 0, bytemuck::bytes_of(&mirror));
         }
+        if self.has_mirrors {
+            self.start_lists(ctx);
+        }
         let mut encoder = ctx
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
@@ -733,6 +755,16 @@ impl Renderer {
         self.profiler.resolve(&mut encoder, names.len() as u32);
         ctx.queue.submit([encoder.finish()]);
         Ok((names, paths))
+    }
+
+    /// Empties the direct pass's lists for the frame about to be submitted (its direct
+    /// pass appends to them). Written with the frame's parameters, before its commands
+    /// run; the gathers of the frame before have run by then (queue order).
+    fn start_lists(&self, ctx: &GpuContext) {
+        let img = self.images.as_ref().expect("image buffers allocated");
+        ctx.queue
+            .write_buffer(&img.mirror_list, 0, &[0; 4 * MAX_SUBSETS as usize]);
+        ctx.queue.write_buffer(&img.chain_list, 0, &[0; 4]);
     }
 
     /// The VPL shadow rays of a real frame of `settings` (canonical: every pixel against
@@ -865,7 +897,7 @@ impl Renderer {
             &self.vpl_header,
             &self.halton_perms.1,
         );
-        let [shoot, compact] = self.vpl.steps(paths, self.has_mirrors);
+        let vpl_steps = self.vpl.steps(paths);
         // The direct pass's first walk gathers no VPLs: an empty list (the one shooting
         // writes would keep the two passes apart).
         let direct_first = self.direct.bind(
@@ -911,12 +943,11 @@ impl Renderer {
             "vpl shooting + direct",
             &[
                 Dispatches {
-                    steps: &[shoot],
+                    steps: &[vpl_steps.shoot],
                     scene,
                     pass: &vpl_bind,
                     ranges: None,
                     group3: None,
-                    indirect: None,
                 },
                 Dispatches {
                     steps: &direct_steps,
@@ -924,15 +955,20 @@ impl Renderer {
                     pass: &direct_first,
                     ranges: Some(&first_walk),
                     group3: None,
-                    indirect: None,
                 },
             ],
         );
 
+        // With more light paths than one workgroup shoots and compacts, the compaction
+        // follows in a stage of its own.
+        if let Some(compact) = vpl_steps.compact {
+            let i = stage("vpl list");
+            rec.dispatch(i, "vpl list", &[compact], scene, &vpl_bind, None);
+        }
+
         // The indirect pass over the mirror record (the mirror gather below), gathering
         // only at the pixels the direct pass listed: its bind groups (its parameters and
-        // buffers, the list), and that of the lists and dispatch sizes for the VPL list
-        // stage, in scenes with mirrors.
+        // buffers, the list), in scenes with mirrors.
         let mirror_groups = self.has_mirrors.then(|| {
             let bind = self.indirect.bind(
                 device,
@@ -947,35 +983,8 @@ impl Renderer {
                 ],
             );
             let list = self.indirect.bind_list(device, &img.mirror_list);
-            let sizes = self.vpl.bind_lists(
-                device,
-                &[
-                    &img.mirror_list,
-                    &img.mirror_args,
-                    &img.chain_list,
-                    &img.chain_args,
-                ],
-            );
-            (bind, list, sizes)
+            (bind, list)
         });
-        let one_range = GatherRanges {
-            bind_group: range_group,
-            first: 1,
-            count: 1,
-        };
-        // One dispatch: the compaction, which in scenes with mirrors also sizes the
-        // dispatches over the direct pass's lists (and resets them for the next frame).
-        let compact_step = [compact];
-        let list_parts = [Dispatches {
-            steps: &compact_step,
-            scene,
-            pass: &vpl_bind,
-            ranges: mirror_groups.as_ref().map(|_| &one_range),
-            group3: mirror_groups.as_ref().map(|(_, _, sizes)| sizes),
-            indirect: None,
-        }];
-        let i = stage("vpl list");
-        rec.stage(i, "vpl list", &list_parts);
 
         // The gathers, side by side in one stage (see `Recorder::side_by_side`): each
         // ends on a few slow warps, and each one's tail overlaps the others' work. First
@@ -1004,8 +1013,12 @@ impl Renderer {
                 },
             )
         });
-        let chains_steps = [(self.direct.chains_pipeline(iv), [0, 0, 0])];
-        let list_steps = [(self.indirect.list_pipeline(iv), [0, 0, 0])];
+        let chains_steps = self
+            .direct
+            .chains_steps(full.0, full.1, iv, self.list_grids.1);
+        let list_steps =
+            self.indirect
+                .list_steps(full.0, full.1, a.interleave, iv, self.list_grids.0);
         let indirect_bind = self.indirect.bind(
             device,
             &[
@@ -1039,11 +1052,10 @@ impl Renderer {
                     pass: bind,
                     ranges: Some(&ranges),
                     group3: None,
-                    indirect: Some(&img.chain_args),
                 },
             ));
         }
-        if let Some((mirror_bind, list_bind, _)) = &mirror_groups {
+        if let Some((mirror_bind, list_bind)) = &mirror_groups {
             gathers.push((
                 "mirror indirect",
                 Dispatches {
@@ -1052,7 +1064,6 @@ impl Renderer {
                     pass: mirror_bind,
                     ranges: Some(&ranges),
                     group3: Some(list_bind),
-                    indirect: Some(&img.mirror_args),
                 },
             ));
         }
@@ -1064,7 +1075,6 @@ impl Renderer {
                 pass: &indirect_bind,
                 ranges: Some(&ranges),
                 group3: None,
-                indirect: None,
             },
         ));
         let name = match gathers.len() {
@@ -1073,7 +1083,7 @@ impl Renderer {
             _ => "indirect",
         };
         // What the gathers after the first read: the G-buffer, the mirror record and its
-        // list, and the mirror gather's workgroup counts.
+        // list.
         let read = |buffer| wgpu::BufferTransition {
             buffer,
             state: wgpu::BufferUses::STORAGE_READ_ONLY,
@@ -1089,10 +1099,6 @@ impl Renderer {
                 read(&img.mirror[1]),
                 read(&img.mirror[2]),
                 read(&img.mirror_list),
-                wgpu::BufferTransition {
-                    buffer: &img.mirror_args,
-                    state: wgpu::BufferUses::INDIRECT,
-                },
             ],
             gathers,
         );
@@ -1130,7 +1136,6 @@ impl Renderer {
                     pass: bind,
                     ranges: None,
                     group3: None,
-                    indirect: None,
                 },
             ));
         }
@@ -1162,7 +1167,6 @@ impl Renderer {
                     pass: bind,
                     ranges: None,
                     group3: None,
-                    indirect: None,
                 },
             ));
         }

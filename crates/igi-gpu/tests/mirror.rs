@@ -11,6 +11,8 @@ use igi_core::bvh::{offset_ray_origin, Bvh};
 use igi_core::scene::Scene;
 use igi_core::settings::{InterleavePattern, OutputBuffer, RenderSettings};
 use igi_core::vpl::{reflect, surface_at};
+use igi_gpu::passes::indirect::list_pixels_per_group;
+use igi_gpu::passes::mirror_lanes;
 use igi_gpu::Renderer;
 use std::f32::consts::PI;
 
@@ -118,6 +120,7 @@ fn check_chains(scene: &Scene, settings: &RenderSettings) -> Option<(u32, u32, u
     let frame = renderer.render(&ctx, settings).unwrap();
     let vpls = renderer.read_vpls(&ctx).unwrap();
     assert!(!vpls.is_empty());
+    check_lists(&ctx, scene, &bvh, &mut renderer, settings, &frame);
     let (mut checked, mut chained, mut off) = (0, 0, 0);
     for y in 0..settings.height {
         for x in 0..settings.width {
@@ -136,13 +139,62 @@ fn check_chains(scene: &Scene, settings: &RenderSettings) -> Option<(u32, u32, u
     Some((checked, chained, off))
 }
 
+/// The direct pass's lists of `frame` (just rendered): each mirrored pixel listed once,
+/// and started afresh by the next frame (the same frame again lists the same and gives
+/// the same image; a list that kept the last frame's pixels would gather at them twice).
+/// Then the same frame by a fresh renderer with one workgroup per bucket of the mirror
+/// gather and one for the later walks, each striding over its whole list: the same image
+/// again (fresh, so that no pixel a stride missed keeps the last frame's light).
+fn check_lists(
+    ctx: &igi_gpu::GpuContext,
+    scene: &Scene,
+    bvh: &Bvh,
+    renderer: &mut Renderer,
+    settings: &RenderSettings,
+    frame: &igi_gpu::FrameOutput,
+) {
+    let counters = renderer.list_counters(ctx).unwrap();
+    let (mirror, _chains) = counters.split_at(igi_gpu::frame::MAX_SUBSETS as usize);
+    let mirrored = frame_mirrored_pixels(renderer, ctx);
+    assert_eq!(
+        mirror.iter().sum::<u32>(),
+        mirrored,
+        "mirrored pixels listed"
+    );
+    let again = renderer.render(ctx, settings).unwrap();
+    assert_eq!(renderer.list_counters(ctx).unwrap(), counters);
+    assert!(
+        again.image.data == frame.image.data,
+        "the second frame differs from the first"
+    );
+    let mut narrow = Renderer::new(ctx, scene, bvh).unwrap();
+    narrow.set_list_grids(1, 1);
+    let strided = narrow.render(ctx, settings).unwrap();
+    assert!(
+        strided.image.data == frame.image.data,
+        "one workgroup striding over each list changes the image"
+    );
+}
+
+/// Pixels whose chain has a mirrored hit, from the mirror record (its weight's w).
+fn frame_mirrored_pixels(renderer: &Renderer, ctx: &igi_gpu::GpuContext) -> u32 {
+    renderer
+        .mirror_weights(ctx)
+        .unwrap()
+        .iter()
+        .filter(|w| w[3] > 0.0)
+        .count() as u32
+}
+
 #[test]
 fn mirrored_hits_gather_from_all_vpls() {
     // The floor becomes half mirror, half diffuse.
     let scene = mirror_floor(Vec3::splat(0.3), Vec3::splat(0.5));
+    // Large enough that the mirrored pixels fill more than one workgroup of the mirror
+    // gather, so that check_lists's single workgroup strides (checked below).
     let settings = RenderSettings {
-        width: 48,
-        height: 48,
+        width: 64,
+        height: 64,
         vpls: 60,
         mirror_depth: 1,
         output: OutputBuffer::Direct,
@@ -155,6 +207,12 @@ fn mirrored_hits_gather_from_all_vpls() {
     assert!(
         checked > 200,
         "the floor should fill the bottom of the image: {checked}"
+    );
+    let software = gpu().is_some_and(|c| c.info.device_type == wgpu::DeviceType::Cpu);
+    let per_group = list_pixels_per_group(mirror_lanes(software));
+    assert!(
+        checked > per_group,
+        "{checked} mirrored pixels fit one workgroup of {per_group}: no stride tested"
     );
     // A shadow ray grazing an edge may decide differently on the GPU; a few, no more.
     assert!(
@@ -235,6 +293,10 @@ fn interleaved_mirrored_hits_stay_close_to_the_full_gather() {
         il.accelerations.interleave = (3, 3);
         il.accelerations.pattern = pattern;
         compare_interleaved(&scene, &base, &full, &render(&ctx, &scene, &il), pattern);
+        let bvh = Bvh::build(&scene.triangles);
+        let mut renderer = Renderer::new(&ctx, &scene, &bvh).unwrap();
+        let frame = renderer.render(&ctx, &il).unwrap();
+        check_lists(&ctx, &scene, &bvh, &mut renderer, &il, &frame);
     }
 }
 

@@ -32,7 +32,7 @@ fn chained_stage_times_add_up_to_the_frame() {
         };
         let frame = render(&ctx, &scene, &settings);
         let frame_ms = frame.frame_ms.expect("a frame time with timestamps");
-        assert!(frame.stages.len() >= 4, "{setup}: {:?}", frame.stages);
+        assert!(frame.stages.len() >= 3, "{setup}: {:?}", frame.stages);
         assert!(
             frame.stages.iter().all(|s| s.ms >= 0.0),
             "{setup}: {:?}",

@@ -8,27 +8,49 @@ use igi_core::sampling::{halton_base, DigitPermutations};
 use igi_core::scene::builtin;
 use igi_core::settings::RenderSettings;
 use igi_core::vpl::shoot_vpls;
+use igi_gpu::passes::vpl::COMPACT_GROUP;
 use igi_gpu::Renderer;
 
+/// Both ways the GPU makes the VPL list: one workgroup that shoots and compacts (up to
+/// `COMPACT_GROUP` paths), and shooting followed by a compaction dispatch (more paths).
 #[test]
 fn gpu_vpls_equal_cpu_twin() {
     let Some(ctx) = gpu() else { return };
     let scene = builtin::builtin_scene("cornell-box").expect("built-in");
     let bvh = Bvh::build(&scene.triangles);
-    let settings = RenderSettings {
-        width: 8,
-        height: 8,
-        vpls: 400,
-        bounces: 5,
-        seed: 3,
-        ..RenderSettings::default()
-    };
     let mut renderer = Renderer::new(&ctx, &scene, &bvh).unwrap();
-    let frame = renderer.render(&ctx, &settings).unwrap();
-    let gpu = renderer.read_vpls(&ctx).unwrap();
+    for (vpls, one_workgroup) in [(400, true), (1500, false)] {
+        let settings = RenderSettings {
+            width: 8,
+            height: 8,
+            vpls,
+            bounces: 5,
+            seed: 3,
+            ..RenderSettings::default()
+        };
+        let frame = renderer.render(&ctx, &settings).unwrap();
+        assert_eq!(
+            frame.path_count <= COMPACT_GROUP,
+            one_workgroup,
+            "{} paths for {vpls} VPLs: the case is not the one meant",
+            frame.path_count
+        );
+        compare_with_twin(&ctx, &renderer, &scene, &bvh, &settings, &frame);
+    }
+}
+
+fn compare_with_twin(
+    ctx: &igi_gpu::GpuContext,
+    renderer: &Renderer,
+    scene: &igi_core::scene::Scene,
+    bvh: &Bvh,
+    settings: &RenderSettings,
+    frame: &igi_gpu::FrameOutput,
+) {
+    let gpu = renderer.read_vpls(ctx).unwrap();
     let cpu = shoot_vpls(
-        &scene,
-        &bvh,
+        scene,
+        bvh,
         &DigitPermutations::new(settings.seed),
         frame.path_count,
         settings.bounces,

@@ -223,7 +223,6 @@ fn bench_runs_tiny_and_its_json_parses() {
         names,
         [
             "vpl shooting + direct",
-            "vpl list",
             "indirect",
             "discontinuity",
             "upsample + compose"

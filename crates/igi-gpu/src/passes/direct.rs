@@ -9,6 +9,16 @@ use crate::scene_buffers::{READ, UNIFORM, WRITE};
 /// (docs/PERFORMANCE.md, attempt 32).
 pub const DIRECT_TILE: (u32, u32) = (8, 4);
 
+/// Listed chains per workgroup of the later walks (`CHAIN_GROUP` in frame.wgsl).
+pub const CHAIN_GROUP: u32 = 32;
+
+/// The most workgroups of the later walks, which stride over the list of chains: its
+/// length is known only on the GPU, and a dispatch sized there (by the first walk, or by
+/// a dispatch after it) cost the frame more than a fixed grid (docs/PERFORMANCE.md
+/// attempt 75). 2048 x 32 threads; a grid over every pixel, most of them skipped, took
+/// 0.018 ms of the H200 in a scene without chains (attempt 50).
+pub const CHAIN_WORKGROUPS: u32 = 2048;
+
 pub struct DirectPass {
     pub layout: wgpu::BindGroupLayout,
     /// The first walk over every pixel (`main`).
@@ -56,10 +66,19 @@ impl DirectPass {
         }
     }
 
-    /// The later walks over the listed chains (dispatched indirectly, sized by the VPL
-    /// list stage: `VplPass::bind_lists`).
-    pub fn chains_pipeline(&self, imperfect_visibility: bool) -> &wgpu::ComputePipeline {
-        self.chains.get(imperfect_visibility)
+    /// The later walks over the listed chains of a `width` x `height` image: a fixed
+    /// grid, no larger than the longest list could need and `most_groups` at most, that
+    /// strides over the list.
+    pub fn chains_steps(
+        &self,
+        width: u32,
+        height: u32,
+        imperfect_visibility: bool,
+        most_groups: u32,
+    ) -> [(&wgpu::ComputePipeline, [u32; 3]); 1] {
+        let most = (width as u64 * height as u64).div_ceil(CHAIN_GROUP as u64);
+        let groups = most.clamp(1, most_groups.max(1) as u64) as u32;
+        [(self.chains.get(imperfect_visibility), [groups, 1, 1])]
     }
 
     pub fn bind(

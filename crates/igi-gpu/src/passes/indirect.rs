@@ -15,11 +15,16 @@ pub fn list_group(lanes: u32) -> u32 {
     256.max(32 * lanes)
 }
 
-/// Listed pixels per workgroup of that gather (its dispatch is sized by the VPL list
-/// stage, vpl.wgsl `MIRROR_LIST_PIXELS`).
+/// Listed pixels per workgroup of that gather.
 pub fn list_pixels_per_group(lanes: u32) -> u32 {
     list_group(lanes) / lanes
 }
+
+/// The most workgroups of the gather over the list of mirrored pixels, over all its
+/// buckets: they stride over the list, whose length is known only on the GPU (a dispatch
+/// sized there cost the frame more than a fixed grid, docs/PERFORMANCE.md attempt 75).
+/// 1024 workgroups of 256 threads are about two waves of the H200's 132 SMs.
+pub const LIST_WORKGROUPS: u32 = 1024;
 
 pub struct IndirectPass {
     pub layout: wgpu::BindGroupLayout,
@@ -29,6 +34,8 @@ pub struct IndirectPass {
     list_layout: wgpu::BindGroupLayout,
     /// The gather over the listed pixels (`main_list`).
     list: GatherPipelines,
+    /// Listed pixels per workgroup of `main_list`.
+    list_pixels: u32,
 }
 
 impl IndirectPass {
@@ -59,6 +66,7 @@ impl IndirectPass {
                 &[scene_layout, &layout, range_layout],
             ),
             list: GatherPipelines::new(device, "indirect", "main_list", &layouts, &constants),
+            list_pixels: list_pixels_per_group(list_lanes),
             list_layout,
             layout,
         }
@@ -69,10 +77,24 @@ impl IndirectPass {
         bind(device, "mirror list", &self.list_layout, &[list])
     }
 
-    /// The gather over the listed pixels (dispatched indirectly, sized by the VPL list
-    /// stage: `VplPass::bind_lists`).
-    pub fn list_pipeline(&self, imperfect_visibility: bool) -> &wgpu::ComputePipeline {
-        self.list.get(imperfect_visibility)
+    /// The gather over the listed pixels of a `width` x `height` image interleaved in
+    /// `subsets` subsets (one bucket each, a z layer each): a fixed grid per bucket, no
+    /// larger than the fullest bucket could need, about `most_groups` in all at most
+    /// (at least one per bucket).
+    pub fn list_steps(
+        &self,
+        width: u32,
+        height: u32,
+        interleave: (u32, u32),
+        imperfect_visibility: bool,
+        most_groups: u32,
+    ) -> [(&wgpu::ComputePipeline, [u32; 3]); 1] {
+        let (n, m) = interleave;
+        let subsets = n * m;
+        let bucket = width.div_ceil(n) as u64 * height.div_ceil(m) as u64;
+        let most = bucket.div_ceil(self.list_pixels as u64);
+        let groups = most.clamp(1, most_groups.div_ceil(subsets).max(1) as u64) as u32;
+        [(self.list.get(imperfect_visibility), [groups, 1, subsets])]
     }
 
     pub fn bind(&self, device: &wgpu::Device, buffers: &[&wgpu::Buffer; 7]) -> wgpu::BindGroup {

@@ -405,9 +405,6 @@ pub(crate) struct Dispatches<'a> {
     pub ranges: Option<&'a GatherRanges<'a>>,
     /// Bind group 3, for the pipelines that have one.
     pub group3: Option<&'a wgpu::BindGroup>,
-    /// Workgroup counts read from this buffer (an indirect dispatch) instead of the
-    /// steps' own.
-    pub indirect: Option<&'a wgpu::Buffer>,
 }
 
 /// The dispatches of several passes in one compute pass (one timestamp pair), run side by
@@ -439,9 +436,8 @@ fn record(cpass: &mut wgpu::ComputePass, parts: &[Dispatches]) {
         }
         for (pipeline, groups) in part.steps {
             cpass.set_pipeline(pipeline);
-            let run = |cpass: &mut wgpu::ComputePass| match part.indirect {
-                Some(args) => cpass.dispatch_workgroups_indirect(args, 0),
-                None => cpass.dispatch_workgroups(groups[0], groups[1], groups[2]),
+            let run = |cpass: &mut wgpu::ComputePass| {
+                cpass.dispatch_workgroups(groups[0], groups[1], groups[2])
             };
             match part.ranges {
                 None => run(cpass),
@@ -522,8 +518,8 @@ impl<'a> Recorder<'a> {
     /// read-write (whether or not either writes it). A barrier waits for every dispatch
     /// before it, so one before the second part would run the parts one after the other
     /// (measured on the H200: docs/PERFORMANCE.md attempt 65). So the parts after the
-    /// first must bind only buffers that are either read-only (or indirect arguments) in
-    /// the state the frame left them in, or put in that state here (`ready`: transitions
+    /// first must bind only buffers that are either read-only in the state the frame
+    /// left them in, or put in that state here (`ready`: transitions
     /// before the stage, where a barrier is due anyway), or bound read-write for the first
     /// time in the frame: their outputs, and spare ray counters
     /// (`SceneBuffers::beside_bind_groups`).
@@ -576,7 +572,6 @@ impl<'a> Recorder<'a> {
                 pass,
                 ranges,
                 group3: None,
-                indirect: None,
             }],
         );
     }

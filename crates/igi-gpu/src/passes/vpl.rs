@@ -1,63 +1,45 @@
 //! VPL shooting (paper section 4, first stage): light paths from the point lights leave
-//! VPLs at diffuse hits; a compaction step makes a dense list (and, in scenes with
-//! mirrors, sizes the dispatches over the direct pass's lists). See `shaders/vpl.wgsl`.
+//! VPLs at diffuse hits, compacted into a dense list. See `shaders/vpl.wgsl`.
 
-use super::{bind, pass_layout, pipeline, pipeline_with_constants};
+use super::{bind, pass_layout, pipeline};
 use crate::scene_buffers::{READ, UNIFORM, WRITE};
 
 /// Threads per workgroup of the shooting kernel (`SHOOT_GROUP` in the WGSL).
 pub const SHOOT_GROUP: u32 = 64;
+/// The most paths that one workgroup shoots and compacts (`COMPACT_GROUP` in the WGSL).
+pub const COMPACT_GROUP: u32 = 256;
 /// Largest number of workgroups in one dimension of a dispatch.
 const MAX_GROUPS: u32 = 65535;
+
+/// A dispatch: a pipeline and its workgroup counts.
+pub type Step<'a> = (&'a wgpu::ComputePipeline, [u32; 3]);
 
 pub struct VplPass {
     pub layout: wgpu::BindGroupLayout,
     shoot: wgpu::ComputePipeline,
     compact: wgpu::ComputePipeline,
-    /// Bind group 3 of `compact_and_size`: the direct pass's lists of mirrored pixels and
-    /// of chains, and the workgroup counts of the dispatches over them.
-    lists_layout: wgpu::BindGroupLayout,
-    /// Compaction that also sizes those dispatches (`compact_and_size`).
-    compact_and_size: wgpu::ComputePipeline,
+    /// Shooting and compaction in one workgroup (`shoot_and_compact`).
+    shoot_and_compact: wgpu::ComputePipeline,
+}
+
+/// The dispatches that make the VPL list: `shoot`, then `compact` where it is a dispatch
+/// of its own (more paths than one workgroup holds), after a barrier.
+pub struct VplSteps<'a> {
+    pub shoot: Step<'a>,
+    pub compact: Option<Step<'a>>,
 }
 
 impl VplPass {
-    /// `mirror_list_pixels`: listed pixels per workgroup of the mirror gather
-    /// (`indirect::list_pixels_per_group`); `range_layout`: bind group 2 of
-    /// `compact_and_size` (unused, before its group 3).
-    pub fn new(
-        device: &wgpu::Device,
-        scene_layout: &wgpu::BindGroupLayout,
-        range_layout: &wgpu::BindGroupLayout,
-        mirror_list_pixels: u32,
-    ) -> VplPass {
+    pub fn new(device: &wgpu::Device, scene_layout: &wgpu::BindGroupLayout) -> VplPass {
         // params, vpl_slots, vpls, vpl_header, halton_perms
         let layout = pass_layout(device, "vpl", &[UNIFORM, WRITE, WRITE, WRITE, READ]);
-        // mirror_list, mirror_args, chain_list, chain_args
-        let lists_layout = pass_layout(device, "vpl lists", &[WRITE, WRITE, WRITE, WRITE]);
+        let layouts = [scene_layout, &layout];
         VplPass {
-            shoot: pipeline(device, "vpl", "shoot", &[scene_layout, &layout]),
-            compact: pipeline(device, "vpl", "compact", &[scene_layout, &layout]),
-            compact_and_size: pipeline_with_constants(
-                device,
-                "vpl",
-                "compact_and_size",
-                &[scene_layout, &layout, range_layout, &lists_layout],
-                &[("MIRROR_LIST_PIXELS", mirror_list_pixels as f64)],
-            ),
-            lists_layout,
+            shoot: pipeline(device, "vpl", "shoot", &layouts),
+            compact: pipeline(device, "vpl", "compact", &layouts),
+            shoot_and_compact: pipeline(device, "vpl", "shoot_and_compact", &layouts),
             layout,
         }
-    }
-
-    /// Bind group 3 of the compaction step that sizes the dispatches over the direct
-    /// pass's lists: `[mirror_list, mirror_args, chain_list, chain_args]`.
-    pub fn bind_lists(
-        &self,
-        device: &wgpu::Device,
-        buffers: &[&wgpu::Buffer; 4],
-    ) -> wgpu::BindGroup {
-        bind(device, "vpl lists", &self.lists_layout, buffers)
     }
 
     pub fn bind(
@@ -77,18 +59,22 @@ impl VplPass {
         )
     }
 
-    /// The two dispatches of the stage for `paths` light paths: shoot, then compact (and,
-    /// with `size_lists`, size the dispatches over the direct pass's lists: bind group 3
-    /// from [`Self::bind_lists`]).
-    pub fn steps(&self, paths: u32, size_lists: bool) -> [(&wgpu::ComputePipeline, [u32; 3]); 2] {
-        let groups = paths.div_ceil(SHOOT_GROUP).max(1);
+    /// The dispatches for `paths` light paths: one workgroup that shoots and compacts for
+    /// up to [`COMPACT_GROUP`] paths, else shooting over as many workgroups as needed and
+    /// the compaction after it.
+    pub fn steps(&self, paths: u32) -> VplSteps<'_> {
+        if paths <= COMPACT_GROUP {
+            return VplSteps {
+                shoot: (&self.shoot_and_compact, [1, 1, 1]),
+                compact: None,
+            };
+        }
+        let groups = paths.div_ceil(SHOOT_GROUP);
         let x = groups.min(MAX_GROUPS);
         let y = groups.div_ceil(x);
-        let compact = if size_lists {
-            &self.compact_and_size
-        } else {
-            &self.compact
-        };
-        [(&self.shoot, [x, y, 1]), (compact, [1, 1, 1])]
+        VplSteps {
+            shoot: (&self.shoot, [x, y, 1]),
+            compact: Some((&self.compact, [1, 1, 1])),
+        }
     }
 }

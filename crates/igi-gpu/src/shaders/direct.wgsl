@@ -31,15 +31,14 @@
 @group(1) @binding(11) var<storage, read_write> mirror_weight: array<vec4<f32>>;
 // The pixels that have such a hit, for the mirror indirect stage to gather at only them,
 // in one bucket per interleaving subset (see mirror_bucket in gather.wgsl): [s] counts
-// the pixels appended to bucket s (reset by vpl.wgsl's compact_and_size once it has
-// read them), [MAX_SUBSETS + s] is that stage's copy of the count, bucket s starts at
-// 2 MAX_SUBSETS + s mirror_bucket_size().
+// the pixels appended to bucket s (zeroed before each frame by frame.rs), bucket s
+// starts at MAX_SUBSETS + s mirror_bucket_size().
 @group(1) @binding(12) var<storage, read_write> mirror_list: array<atomic<u32>>;
 // The pixels whose chain has hits seen in a mirror seen in a mirror, for the later walks:
-// [0] counts those the first walk appended (reset by vpl.wgsl's compact_and_size once it
-// has read it), [1] is the later walks' copy of the count, the pixels follow from [2] on.
-// (A dispatch over the whole image that skipped the others took 0.018 ms of the H200 in
-// the conference room, which has none: docs/PERFORMANCE.md attempt 50.)
+// [0] counts those the first walk appended (zeroed before each frame by frame.rs), the
+// pixels follow from [1] on. (A dispatch over the whole image that skipped the others
+// took 0.018 ms of the H200 in the conference room, which has none: docs/PERFORMANCE.md
+// attempt 50.)
 @group(1) @binding(13) var<storage, read_write> chain_list: array<atomic<u32>>;
 
 // The first walk: one thread per pixel, 8 x 4 pixels (one warp) per workgroup: 8 x 8 took
@@ -53,15 +52,18 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     shade(gid.x, gid.y);
 }
 
-// A later walk over the listed pixels, one thread each.
+// The later walks over the listed pixels, one thread each: a fixed grid (frame.rs
+// sizes it by the image, not by the list) strides over the list, so that nothing has to
+// size the dispatch between the first walk and this one (docs/PERFORMANCE.md attempt
+// 75).
 @compute @workgroup_size(CHAIN_GROUP)
 fn chains_main(@builtin(workgroup_id) group: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>, @builtin(local_invocation_index) l: u32) {
-    let slot = (group.x + group.y * groups.x) * CHAIN_GROUP + l;
-    if (slot >= atomicLoad(&chain_list[1])) {
-        return;
+    let count = atomicLoad(&chain_list[0]);
+    let stride = groups.x * groups.y * CHAIN_GROUP;
+    for (var slot = (group.x + group.y * groups.x) * CHAIN_GROUP + l; slot < count; slot += stride) {
+        let pixel = atomicLoad(&chain_list[1u + slot]);
+        shade(pixel % params.width, pixel / params.width);
     }
-    let pixel = atomicLoad(&chain_list[2u + slot]);
-    shade(pixel % params.width, pixel / params.width);
 }
 
 // Pixel (x, y)'s chain, in the walk `gather_range` says.
@@ -115,7 +117,7 @@ fn shade(x: u32, y: u32) {
                 if (first_walk) {
                     let bucket = interleave_subset(x, y);
                     let slot = atomicAdd(&mirror_list[bucket], 1u);
-                    atomicStore(&mirror_list[2u * MAX_SUBSETS + bucket * mirror_bucket_size() + slot], pixel);
+                    atomicStore(&mirror_list[MAX_SUBSETS + bucket * mirror_bucket_size() + slot], pixel);
                     mirror_position[pixel] = vec4<f32>(s.position, 1.0);
                     mirror_normal[pixel] = vec4<f32>(s.shading_normal, travelled);
                     mirror_geometric[pixel] = vec4<f32>(s.geometric_normal, 0.0);
@@ -145,7 +147,7 @@ fn shade(x: u32, y: u32) {
         count_rays(RAY_MIRROR, traced - 1u);
         if (chained) {
             let slot = atomicAdd(&chain_list[0], 1u);
-            atomicStore(&chain_list[2u + slot], pixel);
+            atomicStore(&chain_list[1u + slot], pixel);
         }
     }
     direct_out[pixel] = vec4<f32>(radiance, 1.0);

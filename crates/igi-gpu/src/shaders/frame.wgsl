@@ -188,16 +188,5 @@ const MAX_SUBSETS: u32 = 64u;
 // Largest workgroup count of one dispatch dimension.
 const MAX_GROUPS: u32 = 65535u;
 
-// The workgroup counts (x, y, z) of an indirect dispatch of `groups` workgroups in each
-// of `layers` z layers: x up to MAX_GROUPS, y as many rows of x as needed; nothing at all
-// when there are no workgroups.
-fn dispatch_size(groups: u32, layers: u32) -> vec3<u32> {
-    let x = min(groups, MAX_GROUPS);
-    if (x == 0u) {
-        return vec3<u32>(0u);
-    }
-    return vec3<u32>(x, (groups + x - 1u) / x, layers);
-}
-
 // Listed pixels per workgroup of the direct pass's later walks (direct.wgsl chains_main).
 const CHAIN_GROUP: u32 = 32u;

@@ -93,9 +93,8 @@ fn main_coherent(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocat
 // whole image spent most of its workgroups on pixels with nothing to gather. The list
 // has one bucket per interleaving subset, so that the 32 pixels of a warp gather the
 // same VPLs in step, as in main_coherent.
-// Its counts were copied to [MAX_SUBSETS + s] by vpl.wgsl's compact_and_size, which
-// also sized this dispatch (LIST_GROUP / VPL_LANES pixels per workgroup); read-only here,
-// so that nothing keeps this gather from running beside the indirect gather (frame.rs).
+// The list is read-only here, so that nothing keeps this gather from running beside the
+// indirect gather (frame.rs).
 @group(3) @binding(0) var<storage, read> mirror_list: array<u32>;
 
 // Threads of a main_list workgroup: 256, or 32 per lane where that is more, so that a
@@ -105,24 +104,33 @@ override LIST_GROUP: u32 = 256u;
 
 // The gather over the listed pixels of bucket group.z, VPL_LANES threads per pixel, a
 // warp holding one lane of 32 pixels (as main_coherent): they trace to the same VPL at
-// each step. The lanes' sums are added in lane order.
+// each step. The lanes' sums are added in lane order. A fixed grid of workgroups per
+// bucket (frame.rs sizes it by the image, not by the list) strides over the bucket's
+// pixels, so that nothing has to size the dispatch between the direct pass, which
+// lists them, and this gather (docs/PERFORMANCE.md attempt 75).
 @compute @workgroup_size(LIST_GROUP)
 fn main_list(@builtin(workgroup_id) group: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>, @builtin(local_invocation_index) l: u32) {
     let per_group = LIST_GROUP / VPL_LANES;
     let p = l % per_group;
     let lane = l / per_group;
     let bucket = group.z;
-    let slot = (group.x + group.y * groups.x) * per_group + p;
-    let inside = slot < mirror_list[MAX_SUBSETS + bucket];
-    var pixel = 0u;
-    var sum = vec3<f32>(0.0);
-    if (inside) {
-        pixel = mirror_list[2u * MAX_SUBSETS + bucket * mirror_bucket_size() + slot];
-        sum = pixel_sum(pixel % params.low_width, pixel / params.low_width, lane, VPL_LANES);
-    }
-    coherent_sums[l] = vec4<f32>(sum, 0.0);
-    workgroupBarrier();
-    if (inside && lane == 0u) {
-        store_irradiance(pixel % params.low_width, pixel / params.low_width, lanes_total(p, per_group, VPL_LANES));
+    let count = mirror_list[bucket];
+    let stride = groups.x * groups.y * per_group;
+    for (var first = (group.x + group.y * groups.x) * per_group; first < count; first += stride) {
+        let slot = first + p;
+        let inside = slot < count;
+        var pixel = 0u;
+        var sum = vec3<f32>(0.0);
+        if (inside) {
+            pixel = mirror_list[MAX_SUBSETS + bucket * mirror_bucket_size() + slot];
+            sum = pixel_sum(pixel % params.low_width, pixel / params.low_width, lane, VPL_LANES);
+        }
+        coherent_sums[l] = vec4<f32>(sum, 0.0);
+        workgroupBarrier();
+        if (inside && lane == 0u) {
+            store_irradiance(pixel % params.low_width, pixel / params.low_width, lanes_total(p, per_group, VPL_LANES));
+        }
+        // The next pixels' sums overwrite these.
+        workgroupBarrier();
     }
 }

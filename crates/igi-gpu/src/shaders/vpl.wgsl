@@ -5,11 +5,10 @@
 // stored VPLs. Path i is driven by the scrambled Halton sequence at index
 // halton_base + i: dimension 0 picks the light, 1-2 the emission direction, then 3 per
 // segment (direction u, v; continuation).
-// A second entry point compacts the per-path slots into a dense, deterministic VPL list;
-// in scenes with mirrors (`compact_and_size`) it also sizes the dispatches over the lists
-// of pixels the direct pass made (one dispatch for the whole "vpl list" stage: each
-// dispatch of its own cost a barrier, docs/PERFORMANCE.md attempt 68).
-
+// The per-path slots are compacted into a dense, deterministic VPL list: by the shooting
+// workgroup itself when one workgroup holds every path (`shoot_and_compact`, the paper's
+// 30-180 VPLs: a dispatch of its own cost the frame a stage boundary, docs/PERFORMANCE.md
+// attempt 75), else by a second entry point (`compact`) after `shoot`.
 @group(1) @binding(1) var<storage, read_write> vpl_slots: array<Vpl>;
 @group(1) @binding(2) var<storage, read_write> vpls: array<Vpl>;
 @group(1) @binding(3) var<storage, read_write> vpl_header: VplHeader;
@@ -55,9 +54,14 @@ fn light_power_weight(l: u32) -> f32 {
 @compute @workgroup_size(64)
 fn shoot(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
     let path = gid.x + gid.y * groups.x * SHOOT_GROUP;
-    if (path >= params.path_count) {
-        return;
+    if (path < params.path_count) {
+        shoot_path(path);
     }
+}
+
+// Shoots light path `path` into its B slots (empty ones marked so) and returns how many
+// VPLs it stored.
+fn shoot_path(path: u32) -> u32 {
     let index = params.halton_base + path;
     let first_slot = path * params.bounces;
 
@@ -134,49 +138,7 @@ fn shoot(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups)
     for (var k = stored; k < params.bounces; k += 1u) {
         vpl_slots[first_slot + k].valid = 0u;
     }
-}
-
-// The lists of direct.wgsl (see there): the pixels with a mirrored hit, in one bucket
-// per interleaving subset, and the pixels whose chain the later walks follow; and the
-// workgroup counts of the dispatches over them (indirect.wgsl main_list, direct.wgsl
-// chains_main), for dispatch_workgroups_indirect.
-@group(3) @binding(0) var<storage, read_write> mirror_list: array<u32>;
-@group(3) @binding(1) var<storage, read_write> mirror_args: array<u32>;
-@group(3) @binding(2) var<storage, read_write> chain_list: array<u32>;
-@group(3) @binding(3) var<storage, read_write> chain_args: array<u32>;
-
-// Listed pixels per workgroup of the mirror gather (LIST_GROUP / VPL_LANES of
-// indirect.wgsl), set by frame.rs.
-override MIRROR_LIST_PIXELS: u32 = 32u;
-
-// Takes this frame's counts of mirrored pixels, resets the counters for the next frame
-// and sizes the mirror gather's dispatch: one z layer per subset, as many workgroups as
-// the fullest bucket needs.
-fn size_mirror_gather() {
-    let subsets = params.interleave_n * params.interleave_m;
-    var most = 0u;
-    for (var s = 0u; s < subsets; s += 1u) {
-        let n = mirror_list[s];
-        mirror_list[s] = 0u;
-        mirror_list[MAX_SUBSETS + s] = n;
-        most = max(most, n);
-    }
-    let size = dispatch_size((most + MIRROR_LIST_PIXELS - 1u) / MIRROR_LIST_PIXELS, subsets);
-    mirror_args[0] = size.x;
-    mirror_args[1] = size.y;
-    mirror_args[2] = size.z;
-}
-
-// Takes this frame's count of listed chains, resets the counter for the next frame and
-// sizes the later walks' dispatch.
-fn size_chain_walks() {
-    let n = chain_list[0];
-    chain_list[0] = 0u;
-    chain_list[1] = n;
-    let size = dispatch_size((n + CHAIN_GROUP - 1u) / CHAIN_GROUP, 1u);
-    chain_args[0] = size.x;
-    chain_args[1] = size.y;
-    chain_args[2] = size.z;
+    return stored;
 }
 
 const COMPACT_GROUP: u32 = 256u;
@@ -190,16 +152,31 @@ fn compact(@builtin(local_invocation_index) t: u32) {
     compact_slots(t);
 }
 
-// `compact`, with two threads of other warps sizing the dispatches over the lists.
+// Shooting and compaction in one workgroup, for up to COMPACT_GROUP paths: thread t
+// shoots path t, then copies its own VPLs to the list after those of the paths before
+// it (a prefix sum of the workgroup's counts), so the list is the one `compact` makes.
+// A thread reads back only the slots it wrote itself.
 @compute @workgroup_size(256)
-fn compact_and_size(@builtin(local_invocation_index) t: u32) {
-    if (t == 64u) {
-        size_mirror_gather();
+fn shoot_and_compact(@builtin(local_invocation_index) t: u32) {
+    var stored = 0u;
+    if (t < params.path_count) {
+        stored = shoot_path(t);
     }
-    if (t == 128u) {
-        size_chain_walks();
+    chunk_counts[t] = stored;
+    workgroupBarrier();
+    var offset = 0u;
+    for (var i = 0u; i < t; i += 1u) {
+        offset += chunk_counts[i];
     }
-    compact_slots(t);
+    let first_slot = t * params.bounces;
+    for (var k = 0u; k < stored; k += 1u) {
+        vpls[offset + k] = vpl_slots[first_slot + k];
+    }
+    if (t == COMPACT_GROUP - 1u) {
+        vpl_header.count = offset + stored;
+        vpl_header.path_count = params.path_count;
+        vpl_header.slots = params.path_count * params.bounces;
+    }
 }
 
 // Thread t of the compaction (a workgroup of COMPACT_GROUP threads).
