@@ -185,8 +185,5 @@ fn hash_u32(v: u32) -> u32 {
 // Most interleaving subsets (frame.rs MAX_SUBSETS).
 const MAX_SUBSETS: u32 = 64u;
 
-// Largest workgroup count of one dispatch dimension.
-const MAX_GROUPS: u32 = 65535u;
-
 // Listed pixels per workgroup of the direct pass's later walks (direct.wgsl chains_main).
 const CHAIN_GROUP: u32 = 32u;
