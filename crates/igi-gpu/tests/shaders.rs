@@ -2,6 +2,9 @@
 //! in front of a user), and every host/GPU struct has the size and field offsets that
 //! the WGSL declares.
 
+mod common;
+
+use common::wgsl_constant;
 use igi_gpu::layout::{
     BvhNode, DisplayParams, FrameParams, GpuLight, GpuMaterial, TriShading, Vpl,
 };
@@ -152,14 +155,9 @@ fn display_params_match_wgsl() {
 
 /// The value of the WGSL constant `name` (a u32 literal).
 fn wgsl_u32(module: &naga::Module, name: &str) -> u32 {
-    let (_, c) = module
-        .constants
-        .iter()
-        .find(|(_, c)| c.name.as_deref() == Some(name))
-        .unwrap_or_else(|| panic!("no constant {name} in the WGSL"));
-    match module.global_expressions[c.init] {
-        naga::Expression::Literal(naga::Literal::U32(v)) => v,
-        ref e => panic!("{name} is not a u32 literal: {e:?}"),
+    match wgsl_constant(module, name) {
+        naga::Literal::U32(v) => v,
+        l => panic!("{name} is not a u32: {l:?}"),
     }
 }
 
@@ -170,22 +168,16 @@ fn host_constants_match_wgsl() {
         let (name, src) = shaders.iter().find(|(n, _)| *n == pass).unwrap();
         parse_and_validate(name, src)
     };
-    let vpl = module("vpl");
-    assert_eq!(
-        wgsl_u32(&vpl, "COMPACT_GROUP"),
-        igi_gpu::passes::vpl::COMPACT_GROUP
-    );
-    assert_eq!(
-        wgsl_u32(&vpl, "SHOOT_GROUP"),
-        igi_gpu::passes::vpl::SHOOT_GROUP
-    );
-    let direct = module("direct");
-    assert_eq!(
-        wgsl_u32(&direct, "CHAIN_GROUP"),
-        igi_gpu::passes::direct::CHAIN_GROUP
-    );
-    assert_eq!(
-        wgsl_u32(&direct, "MAX_SUBSETS"),
-        igi_gpu::frame::MAX_SUBSETS
-    );
+    for (pass, name, host) in [
+        ("vpl", "COMPACT_GROUP", igi_gpu::passes::vpl::COMPACT_GROUP),
+        ("vpl", "SHOOT_GROUP", igi_gpu::passes::vpl::SHOOT_GROUP),
+        (
+            "direct",
+            "CHAIN_GROUP",
+            igi_gpu::passes::direct::CHAIN_GROUP,
+        ),
+        ("direct", "MAX_SUBSETS", igi_gpu::frame::MAX_SUBSETS),
+    ] {
+        assert_eq!(wgsl_u32(&module(pass), name), host, "{pass}.wgsl {name}");
+    }
 }

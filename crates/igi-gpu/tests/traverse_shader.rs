@@ -2,6 +2,9 @@
 //! IGI) parses and validates with naga, composed as every tracing pass composes it, and
 //! its constants agree with the CPU builder and traversal of igi-core.
 
+mod common;
+
+use common::wgsl_constant;
 use naga::valid::{Capabilities, ValidationFlags, Validator};
 
 const SCENE: &str = include_str!("../src/shaders/scene.wgsl");
@@ -50,32 +53,19 @@ fn traverse_wgsl_matches_the_shared_module() {
     assert_eq!(igi_gpu::shader::TRAVERSE, TRAVERSE);
 }
 
-/// The value of a scalar `const` of the module.
-fn constant(module: &naga::Module, name: &str) -> naga::Literal {
-    let (_, c) = module
-        .constants
-        .iter()
-        .find(|(_, c)| c.name.as_deref() == Some(name))
-        .unwrap_or_else(|| panic!("no const {name}"));
-    match module.global_expressions[c.init] {
-        naga::Expression::Literal(l) => l,
-        ref e => panic!("const {name} is not a literal: {e:?}"),
-    }
-}
-
 #[test]
 fn constants_match_the_cpu_twin() {
     let module = parse_and_validate(&composed());
     assert_eq!(
-        constant(&module, "STACK_SIZE"),
+        wgsl_constant(&module, "STACK_SIZE"),
         naga::Literal::U32(igi_core::bvh::MAX_DEPTH),
         "the traversal stack must hold MAX_DEPTH entries"
     );
     assert_eq!(
-        constant(&module, "NO_HIT"),
+        wgsl_constant(&module, "NO_HIT"),
         naga::Literal::U32(igi_core::bvh::NO_HIT)
     );
-    let f = |name: &str| match constant(&module, name) {
+    let f = |name: &str| match wgsl_constant(&module, name) {
         naga::Literal::F32(x) => x,
         l => panic!("{name}: {l:?}"),
     };

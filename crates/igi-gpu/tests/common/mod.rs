@@ -175,3 +175,16 @@ pub fn icosphere(r: f32, subdivisions: u32, material: u32) -> Vec<Triangle> {
         })
         .collect()
 }
+
+/// The value of a scalar `const` of a WGSL module (tests that host constants match it).
+pub fn wgsl_constant(module: &naga::Module, name: &str) -> naga::Literal {
+    let (_, c) = module
+        .constants
+        .iter()
+        .find(|(_, c)| c.name.as_deref() == Some(name))
+        .unwrap_or_else(|| panic!("no const {name}"));
+    match module.global_expressions[c.init] {
+        naga::Expression::Literal(l) => l,
+        ref e => panic!("const {name} is not a literal: {e:?}"),
+    }
+}
