@@ -855,7 +855,7 @@ impl Renderer {
     }
 
     /// The passes of one frame, in order (kajiya style: the frame reads top to bottom).
-    /// Returns the names of the stages it encoded, one timestamp pair each. Meant to be
+    /// Returns the names of the stages it encoded, one time each. Meant to be
     /// called by [`Renderer::submit_frame`], which first writes the frame's parameters and
     /// empties the direct pass's lists (`start_lists`): a frame encoded without them would
     /// append to the last frame's lists.

@@ -155,7 +155,9 @@ fn check_lists(
 ) {
     let counters = renderer.list_counters(ctx).unwrap();
     let (mirror, _chains) = counters.split_at(igi_gpu::frame::MAX_SUBSETS as usize);
-    let mirrored = frame_mirrored_pixels(renderer, ctx);
+    // The pixels whose chain has a mirrored hit: the mirror record's weight has w = 1.
+    let weights = renderer.mirror_weights(ctx).unwrap();
+    let mirrored = weights.iter().filter(|w| w[3] > 0.0).count() as u32;
     assert_eq!(
         mirror.iter().sum::<u32>(),
         mirrored,
@@ -174,16 +176,6 @@ fn check_lists(
         strided.image.data == frame.image.data,
         "one workgroup striding over each list changes the image"
     );
-}
-
-/// Pixels whose chain has a mirrored hit, from the mirror record (its weight's w).
-fn frame_mirrored_pixels(renderer: &Renderer, ctx: &igi_gpu::GpuContext) -> u32 {
-    renderer
-        .mirror_weights(ctx)
-        .unwrap()
-        .iter()
-        .filter(|w| w[3] > 0.0)
-        .count() as u32
 }
 
 #[test]

@@ -4,12 +4,11 @@
 //! (`IGI_SIDE_BY_SIDE=0`: no gathers or filters side by side) must give the same image,
 //! bit for bit: the barriers wgpu puts between the dispatches of one pass must be all the
 //! frame needs, VPL shooting beside the direct pass, the chain walks and the two gathers
-//! side by side, the two filters side by side and the indirect dispatches over the direct
-//! pass's lists included, and the
-//! state a stage leaves bound (bind groups 2 and 3) must not leak into the next. lavapipe
-//! runs dispatches one after another, so there a missing barrier cannot show; on a GPU it
-//! would. (Its own test binary: it sets IGI_STAGE_PASSES and IGI_SIDE_BY_SIDE for the
-//! whole process.)
+//! side by side, the two filters side by side and the gathers over the direct pass's lists
+//! included, and the state a stage leaves bound (bind groups 2 and 3) must not leak into
+//! the next. lavapipe runs dispatches one after another, so there a missing barrier
+//! cannot show; on a GPU it would. (Its own test binary: it sets IGI_STAGE_PASSES and
+//! IGI_SIDE_BY_SIDE for the whole process.)
 
 mod common;
 

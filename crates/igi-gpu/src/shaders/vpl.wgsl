@@ -144,43 +144,34 @@ fn shoot_path(path: u32) -> u32 {
 const COMPACT_GROUP: u32 = 256u;
 var<workgroup> chunk_counts: array<u32, 256>;
 
-// One workgroup: each thread counts the valid slots of a contiguous chunk, a prefix sum
-// over the chunk counts gives each chunk's output offset, then each thread copies its
-// chunk. Slot order is kept, so the VPL list is the same on every run.
-@compute @workgroup_size(256)
-fn compact(@builtin(local_invocation_index) t: u32) {
-    compact_slots(t);
-}
-
-// Shooting and compaction in one workgroup, for up to COMPACT_GROUP paths: thread t
-// shoots path t, then copies its own VPLs to the list after those of the paths before
-// it (a prefix sum of the workgroup's counts), so the list is the one `compact` makes.
-// A thread reads back only the slots it wrote itself.
-@compute @workgroup_size(256)
-fn shoot_and_compact(@builtin(local_invocation_index) t: u32) {
-    var stored = 0u;
-    if (t < params.path_count) {
-        stored = shoot_path(t);
-    }
-    chunk_counts[t] = stored;
+// Thread t's place in a list to which each thread of the workgroup, in thread order,
+// adds `count` entries: the sum of the counts of the threads before it. Has a workgroup
+// barrier: call it from uniform control flow.
+fn offset_before(t: u32, count: u32) -> u32 {
+    chunk_counts[t] = count;
     workgroupBarrier();
     var offset = 0u;
     for (var i = 0u; i < t; i += 1u) {
         offset += chunk_counts[i];
     }
-    let first_slot = t * params.bounces;
-    for (var k = 0u; k < stored; k += 1u) {
-        vpls[offset + k] = vpl_slots[first_slot + k];
-    }
+    return offset;
+}
+
+// The VPL list's header, written by the workgroup's last thread, `end` its place after
+// its own VPLs: the list's length.
+fn write_header(t: u32, end: u32) {
     if (t == COMPACT_GROUP - 1u) {
-        vpl_header.count = offset + stored;
+        vpl_header.count = end;
         vpl_header.path_count = params.path_count;
         vpl_header.slots = params.path_count * params.bounces;
     }
 }
 
-// Thread t of the compaction (a workgroup of COMPACT_GROUP threads).
-fn compact_slots(t: u32) {
+// One workgroup: each thread counts the valid slots of a contiguous chunk, a prefix sum
+// over the chunk counts gives each chunk's output offset, then each thread copies its
+// chunk. Slot order is kept, so the VPL list is the same on every run.
+@compute @workgroup_size(256)
+fn compact(@builtin(local_invocation_index) t: u32) {
     let slots = params.path_count * params.bounces;
     let chunk = (slots + COMPACT_GROUP - 1u) / COMPACT_GROUP;
     let begin = min(t * chunk, slots);
@@ -189,21 +180,30 @@ fn compact_slots(t: u32) {
     for (var s = begin; s < end; s += 1u) {
         count += vpl_slots[s].valid;
     }
-    chunk_counts[t] = count;
-    workgroupBarrier();
-    var offset = 0u;
-    for (var i = 0u; i < t; i += 1u) {
-        offset += chunk_counts[i];
-    }
+    var offset = offset_before(t, count);
     for (var s = begin; s < end; s += 1u) {
         if (vpl_slots[s].valid != 0u) {
             vpls[offset] = vpl_slots[s];
             offset += 1u;
         }
     }
-    if (t == COMPACT_GROUP - 1u) {
-        vpl_header.count = offset;
-        vpl_header.path_count = params.path_count;
-        vpl_header.slots = slots;
+    write_header(t, offset);
+}
+
+// Shooting and compaction in one workgroup, for up to COMPACT_GROUP paths: thread t
+// shoots path t, then copies its own VPLs to the list after those of the paths before
+// it, so the list is the one `compact` makes. A thread reads back only the slots it
+// wrote itself.
+@compute @workgroup_size(256)
+fn shoot_and_compact(@builtin(local_invocation_index) t: u32) {
+    var stored = 0u;
+    if (t < params.path_count) {
+        stored = shoot_path(t);
     }
+    let offset = offset_before(t, stored);
+    let first_slot = t * params.bounces;
+    for (var k = 0u; k < stored; k += 1u) {
+        vpls[offset + k] = vpl_slots[first_slot + k];
+    }
+    write_header(t, offset + stored);
 }
