@@ -2,8 +2,9 @@
 //! Marques and Santos) on a scene: median wall time of several builds, the tree's size
 //! and SAH cost, and a CPU traversal sanity figure.
 //!
-//! `cargo run --release -p igi-core --example bvh_build -- [SCENE.toml|MESH.obj] [RUNS]`
-//! (default: the conference room of `shared/scenes`, 5 runs). An OBJ is read as bare
+//! `cargo run --release -p igi-core --example bvh_build -- [SCENE.toml|MESH.obj] [RUNS]
+//! [--splits]` (default: the conference room of `shared/scenes`, 5 runs; `--splits`
+//! measures `BvhBuilder::Split`, early split clipping). An OBJ is read as bare
 //! triangles with `tobj`, every face kept (the scene loader may drop degenerate ones).
 
 use std::path::PathBuf;
@@ -14,7 +15,8 @@ use igi_core::scene::{load_scene, Triangle};
 use igi_core::Vec3;
 
 fn main() {
-    let mut args = std::env::args().skip(1);
+    let splits = std::env::args().any(|a| a == "--splits");
+    let mut args = std::env::args().skip(1).filter(|a| a != "--splits");
     let path = PathBuf::from(
         args.next()
             .unwrap_or_else(|| "/work/shared/scenes/conference/scene.toml".to_string()),
@@ -53,7 +55,11 @@ fn main() {
     let cpu_start = process_cpu_seconds();
     for _ in 0..runs {
         let t = Instant::now();
-        let b = Bvh::build(&triangles);
+        let b = if splits {
+            Bvh::build_with(&triangles, igi_core::bvh::BvhBuilder::Split)
+        } else {
+            Bvh::build(&triangles)
+        };
         times.push(t.elapsed().as_secs_f64() * 1e3);
         bvh = Some(b);
     }
@@ -74,7 +80,8 @@ fn main() {
         times[runs - 1]
     );
     println!(
-        "nodes {} ({} KiB), leaves {}, max depth {}, max leaf {}, oversized leaves {}, SAH cost {:.2}",
+        "references {}, nodes {} ({} KiB), leaves {}, max depth {}, max leaf {}, oversized leaves {}, SAH cost {:.2}",
+        s.references,
         s.nodes,
         s.nodes * std::mem::size_of::<igi_core::bvh::BvhNode>() / 1024,
         s.leaves,

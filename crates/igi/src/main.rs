@@ -4,7 +4,7 @@
 
 use anyhow::{bail, Context, Result};
 use clap::{Args, Parser, Subcommand, ValueEnum};
-use igi_core::bvh::Bvh;
+use igi_core::bvh::{Bvh, BvhBuilder};
 use igi_core::scene::{builtin, load_scene, Scene};
 use igi_core::settings::{
     Accelerations, FilterMode, GeometryBound, InterleavePattern, OutputBuffer, RenderSettings,
@@ -110,6 +110,10 @@ struct RaysArgs {
     height: Option<u32>,
     #[arg(long, default_value_t = 0)]
     seed: u32,
+    /// BVH builder: binned (fast build) or split (early split clipping: about twice the
+    /// build time, a faster walk on scenes of long thin triangles).
+    #[arg(long, value_enum, default_value = "binned")]
+    bvh: BvhArg,
     /// Adapter: an index or part of a name from `igi info`.
     #[arg(long)]
     adapter: Option<String>,
@@ -151,12 +155,33 @@ struct BenchArgs {
     height: Option<u32>,
     #[arg(long, default_value_t = 0)]
     seed: u32,
+    /// BVH builder: binned (fast build) or split (early split clipping: about twice the
+    /// build time, a faster walk on scenes of long thin triangles).
+    #[arg(long, value_enum, default_value = "binned")]
+    bvh: BvhArg,
     /// Adapter: an index or part of a name from `igi info`.
     #[arg(long)]
     adapter: Option<String>,
     /// No progress bar.
     #[arg(long)]
     quiet: bool,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum BvhArg {
+    /// Binned SAH over whole triangles.
+    Binned,
+    /// Binned SAH with early split clipping of long thin triangles.
+    Split,
+}
+
+impl From<BvhArg> for BvhBuilder {
+    fn from(a: BvhArg) -> BvhBuilder {
+        match a {
+            BvhArg::Binned => BvhBuilder::Binned,
+            BvhArg::Split => BvhBuilder::Split,
+        }
+    }
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -220,6 +245,10 @@ struct FrameArgs {
     /// Seed of the VPL set (a window of the Halton sequence).
     #[arg(long, default_value_t = 0)]
     seed: u32,
+    /// BVH builder: binned (fast build) or split (early split clipping: about twice the
+    /// build time, a faster walk on scenes of long thin triangles).
+    #[arg(long, value_enum, default_value = "binned")]
+    bvh: BvhArg,
     /// Adapter to use: an index or part of a name from `igi info` (default: the best).
     #[arg(long)]
     adapter: Option<String>,
@@ -511,6 +540,7 @@ fn view(args: &ViewArgs) -> Result<()> {
         max_accumulate: args.max_accumulate.max(args.frame.accel.accumulate),
         render_scale: args.scale,
         show_vpls: args.vpl_dots,
+        bvh: args.frame.bvh.into(),
         window: args.window,
         scene,
     })
@@ -576,13 +606,15 @@ fn render(args: &RenderArgs) -> Result<()> {
     settings.exposure = args.exposure;
     settings.output = output_buffer(args.buffer);
     let t = Instant::now();
-    let bvh = Bvh::build(&scene.triangles);
+    let builder = args.frame.bvh.into();
+    let bvh = Bvh::build_with(&scene.triangles, builder);
     let bvh_ms = t.elapsed().as_secs_f64() * 1e3;
     eprintln!(
-        "scene {}: {} triangles, {} lights (loaded in {load_ms:.0} ms, BVH built in {bvh_ms:.1} ms)",
+        "scene {}: {} triangles, {} lights (loaded in {load_ms:.0} ms, {})",
         scene.source,
         scene.triangles.len(),
-        scene.lights.len()
+        scene.lights.len(),
+        igi::bvh_built(&bvh, builder, bvh_ms)
     );
     let ctx = GpuContext::new(&AdapterChoice::from_option(args.frame.adapter.as_deref()))?;
     eprintln!("adapter: {}", ctx.describe());
@@ -655,6 +687,7 @@ fn bench(args: &BenchArgs) -> Result<()> {
         width: args.width,
         height: args.height,
         seed: args.seed,
+        bvh: args.bvh.into(),
         adapter: args.adapter.clone(),
         quiet: args.quiet,
         command: std::env::args().collect::<Vec<_>>().join(" "),
@@ -684,7 +717,8 @@ fn bench_rays(args: &RaysArgs) -> Result<()> {
     }
     let scene = igi::bench::run::load(&args.scene)?;
     let t = Instant::now();
-    let bvh = Bvh::build(&scene.triangles);
+    let builder = args.bvh.into();
+    let bvh = Bvh::build_with(&scene.triangles, builder);
     let bvh_ms = t.elapsed().as_secs_f64() * 1e3;
     let ctx = GpuContext::new(&AdapterChoice::from_option(args.adapter.as_deref()))?;
     if !ctx.timestamps {
@@ -694,9 +728,10 @@ fn bench_rays(args: &RaysArgs) -> Result<()> {
         );
     }
     eprintln!(
-        "scene {}: {} triangles, BVH built in {bvh_ms:.1} ms; adapter: {}",
+        "scene {}: {} triangles, {}; adapter: {}",
         scene.source,
         scene.triangles.len(),
+        igi::bvh_built(&bvh, builder, bvh_ms),
         ctx.describe()
     );
     let queries: Vec<RayQuery> = match args.kind {

@@ -16,6 +16,7 @@ fn results() -> BenchResults {
                 scene_path: "scenes/interior.toml".into(),
                 triangles: 1000,
                 bvh_build_ms: 1.5,
+                bvh: "binned".to_string(),
                 width: 800,
                 height: 600,
                 setup: setup.into(),

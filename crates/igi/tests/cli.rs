@@ -278,6 +278,28 @@ fn bench_rays_saves_and_loads_the_same_rays() {
         s.split(", ").nth(1).unwrap_or_default().to_string()
     };
     assert_eq!(fraction(&first), fraction(&second));
+    // The split BVH (early split clipping) gives every any-hit answer the same.
+    let split = igi(&[
+        "bench",
+        "rays",
+        "builtin:cornell-box",
+        "--kind",
+        "shadow",
+        "--runs",
+        "1",
+        "--bvh",
+        "split",
+        "--load",
+        file.to_str().unwrap(),
+    ]);
+    assert!(split.status.success());
+    assert!(String::from_utf8_lossy(&split.stderr).contains("split BVH of"));
+    let hash = |o: &Output| {
+        let s = String::from_utf8_lossy(&o.stdout).to_string();
+        let at = s.find("answers hash").expect("an answers hash");
+        s[at..at + 29].to_string()
+    };
+    assert_eq!(hash(&second), hash(&split));
     // A file that is not a ray file is one clear error.
     std::fs::write(&file, b"not rays").unwrap();
     let bad = igi(&[

@@ -45,37 +45,37 @@ const SMALL_RANGE: usize = 12;
 const FEW_BINS_BELOW: usize = 256;
 
 #[derive(Clone, Copy, Debug)]
-struct Aabb {
-    lo: Vec3A,
-    hi: Vec3A,
+pub(super) struct Aabb {
+    pub(super) lo: Vec3A,
+    pub(super) hi: Vec3A,
 }
 
 impl Aabb {
-    const EMPTY: Aabb = Aabb {
+    pub(super) const EMPTY: Aabb = Aabb {
         lo: Vec3A::INFINITY,
         hi: Vec3A::NEG_INFINITY,
     };
 
     #[inline]
-    fn grow(&mut self, o: &Aabb) {
+    pub(super) fn grow(&mut self, o: &Aabb) {
         self.lo = self.lo.min(o.lo);
         self.hi = self.hi.max(o.hi);
     }
 
     #[inline]
-    fn grow_point(&mut self, p: Vec3A) {
+    pub(super) fn grow_point(&mut self, p: Vec3A) {
         self.lo = self.lo.min(p);
         self.hi = self.hi.max(p);
     }
 
     /// Half the surface area (the SAH only needs ratios); 0 for an empty box.
     #[inline]
-    fn half_area(&self) -> f32 {
+    pub(super) fn half_area(&self) -> f32 {
         let e = (self.hi - self.lo).max(Vec3A::ZERO);
         e.x * e.y + e.y * e.z + e.z * e.x
     }
 
-    fn child(&self, index: u32, count: u32) -> BvhChild {
+    pub(super) fn child(&self, index: u32, count: u32) -> BvhChild {
         BvhChild {
             min: self.lo.into(),
             max: self.hi.into(),
@@ -88,9 +88,9 @@ impl Aabb {
 /// Bounds of one triangle. Its centroid, doubled, is `lo + hi` (the factor 2 is the same
 /// for every primitive, so bins and splits do not care).
 #[derive(Clone, Copy, Debug)]
-struct PrimRef {
-    lo: Vec3A,
-    hi: Vec3A,
+pub(super) struct PrimRef {
+    pub(super) lo: Vec3A,
+    pub(super) hi: Vec3A,
 }
 
 impl PrimRef {
@@ -120,6 +120,8 @@ struct Limits {
     par_levels: u32,
     /// Rotations each node may make on the way up ([`rotate_locally`]; 0: none).
     rotation_budget: u32,
+    /// Early split clipping of the references (`split`).
+    split: bool,
 }
 
 impl Limits {
@@ -129,6 +131,7 @@ impl Limits {
             max_depth,
             par_levels: threads().next_power_of_two().trailing_zeros() + 1,
             rotation_budget,
+            split: false,
         }
     }
 }
@@ -212,6 +215,18 @@ pub(super) fn build_from_vertices(triangles: &[[Vec3; 3]]) -> Bvh {
     )
 }
 
+/// With early split clipping of the references (`split`), any depth cap (tests).
+pub(super) fn build_split<F>(count: usize, tri: F, max_depth: u32) -> Bvh
+where
+    F: Fn(usize) -> [Vec3; 3] + Sync,
+{
+    let limits = Limits {
+        split: true,
+        ..Limits::new(max_depth, ROTATION_BUDGET)
+    };
+    build_impl(count, tri, limits)
+}
+
 /// With every subtree built on the calling thread (the tree must be the same).
 #[cfg(test)]
 pub(super) fn build_on_one_thread(triangles: &[[Vec3; 3]]) -> Bvh {
@@ -247,7 +262,7 @@ pub(super) fn build_with_rotations(triangles: &[[Vec3; 3]], max_depth: u32, budg
     )
 }
 
-fn threads() -> usize {
+pub(super) fn threads() -> usize {
     std::thread::available_parallelism()
         .map(|n| n.get())
         .unwrap_or(1)
@@ -256,7 +271,7 @@ fn threads() -> usize {
 
 /// Runs `f(chunk_start, chunk)` over `data` split into one chunk per thread, each chunk a
 /// multiple of `align` long; returns the results in chunk order.
-fn par_chunks<T: Send, R: Send, F>(data: &mut [T], align: usize, f: F) -> Vec<R>
+pub(super) fn par_chunks<T: Send, R: Send, F>(data: &mut [T], align: usize, f: F) -> Vec<R>
 where
     F: Fn(usize, &mut [T]) -> R + Sync,
 {
@@ -284,7 +299,7 @@ where
 
 /// Counts and areas gathered while building, for [`BuildStats`].
 #[derive(Default)]
-struct Tally {
+pub(super) struct Tally {
     leaves: usize,
     max_leaf_size: u32,
     oversized_leaves: usize,
@@ -293,14 +308,14 @@ struct Tally {
 }
 
 impl Tally {
-    fn leaf(&mut self, count: usize, half_area: f32) {
+    pub(super) fn leaf(&mut self, count: usize, half_area: f32) {
         self.leaves += 1;
         self.max_leaf_size = self.max_leaf_size.max(count as u32);
         self.oversized_leaves += usize::from(count > MAX_LEAF_SIZE);
         self.leaf_area += (half_area * count as f32) as f64;
     }
 
-    fn merge(&mut self, o: Tally) {
+    pub(super) fn merge(&mut self, o: Tally) {
         self.leaves += o.leaves;
         self.max_leaf_size = self.max_leaf_size.max(o.max_leaf_size);
         self.oversized_leaves += o.oversized_leaves;
@@ -323,10 +338,95 @@ where
             nodes: vec![BvhNode::new(BvhChild::EMPTY, BvhChild::EMPTY)],
             tri_verts: vec![],
             tri_order: vec![],
-            build_stats: stats(0, 1, Tally::default(), (0.0, 0), 0.0, start),
+            build_stats: stats(0, 0, 1, Tally::default(), (0.0, 0), 0.0, start),
         };
     }
 
+    let (mut prims, mut ids, bounds, cbounds) = if limits.split {
+        let (prims, ids) = super::split::split_references(count, &tri);
+        let (bounds, cbounds) = range_bounds(&prims);
+        (prims, ids, bounds, cbounds)
+    } else {
+        let (prims, bounds, cbounds) = whole_references(count, &tri);
+        (prims, (0..count as u32).collect(), bounds, cbounds)
+    };
+    // References: one per triangle, or more with early split clipping.
+    let refs = prims.len();
+    assert!(
+        refs <= (u32::MAX / 3) as usize,
+        "too many triangle references for one BVH: {refs}"
+    );
+
+    // Room for refs - 1 interior nodes, the most a tree over refs references has; zeroed
+    // by the allocator, so that the places no subtree writes (see Region) are never
+    // touched.
+    let mut nodes: Vec<BvhNode> = bytemuck::zeroed_vec(refs.max(2) - 1);
+    let mut heights = vec![0u8; nodes.len()];
+    let mut tally = Tally::default();
+    let root = build_node(
+        Task {
+            prims: &mut prims,
+            ids: &mut ids,
+            first: 0,
+            bounds,
+            cbounds,
+            depth: 0,
+        },
+        &mut Region {
+            nodes: &mut nodes,
+            heights: &mut heights,
+            base: 0,
+            used: 0,
+        },
+        &mut tally,
+        &limits,
+    )
+    .0;
+    drop(heights);
+    if root.count > 0 {
+        // A root that is a leaf still needs an interior node 0 to hold its box; the leaf
+        // is its child, at depth 1.
+        nodes[0] = BvhNode::new(bounds.child(root.index, root.count), BvhChild::EMPTY);
+    }
+    drop(prims);
+
+    let mut tri_verts = vec![[0.0f32; 4]; 3 * refs];
+    par_chunks(&mut tri_verts, 3, |base, chunk| {
+        for (k, out) in chunk.chunks_exact_mut(3).enumerate() {
+            let v = tri(ids[base / 3 + k] as usize);
+            for (o, v) in out.iter_mut().zip(v) {
+                *o = [v.x, v.y, v.z, 0.0];
+            }
+        }
+    });
+
+    // Rotations and larger_first moved subtrees around: child a's subtree right after its
+    // parent again.
+    // A binary tree of n leaves has n - 1 interior nodes (a root leaf still needs node 0).
+    let interior = tally.leaves.max(2) - 1;
+    let (nodes, interior_area, deepest) = depth_first_layout(&nodes, interior);
+    let build_stats = stats(
+        count,
+        refs,
+        nodes.len(),
+        tally,
+        (interior_area, deepest),
+        bounds.half_area(),
+        start,
+    );
+    Bvh {
+        nodes,
+        tri_verts,
+        tri_order: ids,
+        build_stats,
+    }
+}
+
+/// One reference per triangle, its box: (boxes, box of all, box of the doubled centroids).
+fn whole_references<F>(count: usize, tri: &F) -> (Vec<PrimRef>, Aabb, Aabb)
+where
+    F: Fn(usize) -> [Vec3; 3] + Sync,
+{
     let mut prims = vec![
         PrimRef {
             lo: Vec3A::ZERO,
@@ -357,70 +457,7 @@ where
         bounds.grow(&b);
         cbounds.grow(&c);
     }
-    let mut ids: Vec<u32> = (0..count as u32).collect();
-
-    // Room for count - 1 interior nodes, the most a tree over count triangles has; zeroed
-    // by the allocator, so that the places no subtree writes (see Region) are never
-    // touched.
-    let mut nodes: Vec<BvhNode> = bytemuck::zeroed_vec(count.max(2) - 1);
-    let mut heights = vec![0u8; nodes.len()];
-    let mut tally = Tally::default();
-    let root = build_node(
-        Task {
-            prims: &mut prims,
-            ids: &mut ids,
-            first: 0,
-            bounds,
-            cbounds,
-            depth: 0,
-        },
-        &mut Region {
-            nodes: &mut nodes,
-            heights: &mut heights,
-            base: 0,
-            used: 0,
-        },
-        &mut tally,
-        &limits,
-    )
-    .0;
-    drop(heights);
-    if root.count > 0 {
-        // A root that is a leaf still needs an interior node 0 to hold its box; the leaf
-        // is its child, at depth 1.
-        nodes[0] = BvhNode::new(bounds.child(root.index, root.count), BvhChild::EMPTY);
-    }
-    drop(prims);
-
-    let mut tri_verts = vec![[0.0f32; 4]; 3 * count];
-    par_chunks(&mut tri_verts, 3, |base, chunk| {
-        for (k, out) in chunk.chunks_exact_mut(3).enumerate() {
-            let v = tri(ids[base / 3 + k] as usize);
-            for (o, v) in out.iter_mut().zip(v) {
-                *o = [v.x, v.y, v.z, 0.0];
-            }
-        }
-    });
-
-    // Rotations and larger_first moved subtrees around: child a's subtree right after its
-    // parent again.
-    // A binary tree of n leaves has n - 1 interior nodes (a root leaf still needs node 0).
-    let interior = tally.leaves.max(2) - 1;
-    let (nodes, interior_area, deepest) = depth_first_layout(&nodes, interior);
-    let build_stats = stats(
-        count,
-        nodes.len(),
-        tally,
-        (interior_area, deepest),
-        bounds.half_area(),
-        start,
-    );
-    Bvh {
-        nodes,
-        tri_verts,
-        tri_order: ids,
-        build_stats,
-    }
+    (prims, bounds, cbounds)
 }
 
 /// Rotations a node may make on the way up of the build (see [`rotate_locally`]).
@@ -568,7 +605,7 @@ fn rotate_node(tree: &mut Region, i: usize, depth: u32, max_depth: u32) -> Optio
 /// One walk that writes each node at its new index and patches its parent's
 /// reference to it: on the conference room, 3.9-4.5 ms of the 2-core machine, against
 /// 9.3-10.7 ms for the three passes it replaced (list the order, renumber, sum).
-fn depth_first_layout(nodes: &[BvhNode], interior: usize) -> (Vec<BvhNode>, f64, u32) {
+pub(super) fn depth_first_layout(nodes: &[BvhNode], interior: usize) -> (Vec<BvhNode>, f64, u32) {
     let mut out: Vec<BvhNode> = Vec::with_capacity(interior);
     let (mut interior_area, mut deepest) = (0.0f64, 0u32);
     // (node, its parent's new index and side (0: a, 1: b), its depth); the root has no parent.
@@ -608,7 +645,7 @@ fn depth_first_layout(nodes: &[BvhNode], interior: usize) -> (Vec<BvhNode>, f64,
 /// step), and the larger box is the one a ray more likely hits (the SAH's own estimate),
 /// so an occluder tends to be found sooner. Frame shadow rays ran 9% faster, random
 /// segments 15% (docs/PERFORMANCE.md, attempt 41). Ties keep the given order.
-fn larger_first(a: BvhChild, b: BvhChild) -> BvhNode {
+pub(super) fn larger_first(a: BvhChild, b: BvhChild) -> BvhNode {
     if b.half_area() > a.half_area() {
         BvhNode::new(b, a)
     } else {
@@ -995,8 +1032,9 @@ fn partition_on<const AXIS: usize>(
     }
 }
 
-fn stats(
+pub(super) fn stats(
     triangles: usize,
+    references: usize,
     nodes: usize,
     t: Tally,
     (interior_area, max_depth): (f64, u32),
@@ -1012,6 +1050,7 @@ fn stats(
     BuildStats {
         build_ms: start.elapsed().as_secs_f64() * 1e3,
         triangles,
+        references,
         nodes,
         leaves: t.leaves,
         max_depth,
@@ -1052,7 +1091,11 @@ pub(super) fn stats_by_walk(bvh: &Bvh) -> BuildStats {
             }
         }
     }
+    let mut distinct = bvh.tri_order.clone();
+    distinct.sort_unstable();
+    distinct.dedup();
     let mut s = stats(
+        distinct.len(),
         bvh.tri_order.len(),
         bvh.nodes.len(),
         t,

@@ -46,16 +46,34 @@ fn random_triangles(r: &mut Pcg64, n: usize, extent: f32, size: f32) -> Vec<[Vec
 /// Checks the structure: tri_order is a permutation, tri_verts follow it, every box
 /// contains what it holds, depth and stack bounds hold.
 fn check_structure(bvh: &Bvh, tris: &[[Vec3; 3]]) {
+    check_structure_of(bvh, tris, BvhBuilder::Binned);
+}
+
+/// The same for either builder: with early split clipping (`Split`) a triangle may fill
+/// several slots, and a leaf's box holds the pieces of its triangles, so it lies inside
+/// the box of its triangles instead of around them.
+fn check_structure_of(bvh: &Bvh, tris: &[[Vec3; 3]], builder: BvhBuilder) {
     let n = tris.len();
-    assert_eq!(bvh.tri_order.len(), n);
-    assert_eq!(bvh.tri_verts.len(), 3 * n);
+    let refs = bvh.tri_order.len();
+    assert_eq!(bvh.build_stats.references, refs);
+    assert_eq!(bvh.build_stats.triangles, n);
+    if builder == BvhBuilder::Binned {
+        assert_eq!(refs, n);
+    }
+    assert_eq!(bvh.tri_verts.len(), 3 * refs);
     let mut seen = vec![false; n];
     for (slot, &i) in bvh.tri_order.iter().enumerate() {
-        assert!(!seen[i as usize], "triangle {i} twice");
+        assert!(
+            builder == BvhBuilder::Split || !seen[i as usize],
+            "triangle {i} twice"
+        );
         seen[i as usize] = true;
-        assert_eq!(bvh.triangle(slot as u32), tris[i as usize]);
+        // By bits: a non-finite vertex may be NaN.
+        let bits = |t: [Vec3; 3]| t.map(|v| v.to_array().map(f32::to_bits));
+        assert_eq!(bits(bvh.triangle(slot as u32)), bits(tris[i as usize]));
     }
-    let mut leaf_slots = vec![false; n];
+    assert!(seen.iter().all(|&s| s), "a triangle in no slot");
+    let mut leaf_slots = vec![false; refs];
     let mut node_seen = vec![false; bvh.nodes.len()];
     // (node, depth, its box)
     let mut stack = vec![(0u32, 0u32, None::<(Vec3, Vec3)>)];
@@ -78,12 +96,24 @@ fn check_structure(bvh: &Bvh, tris: &[[Vec3; 3]]) {
                 assert!(c.min.cmpge(lo).all() && c.max.cmple(hi).all());
             }
             if c.is_leaf() {
+                let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
                 for slot in c.index..c.index + c.count {
                     assert!(!leaf_slots[slot as usize]);
                     leaf_slots[slot as usize] = true;
                     for v in bvh.triangle(slot) {
-                        assert!(v.cmpge(c.min).all() && v.cmple(c.max).all());
+                        if builder == BvhBuilder::Binned {
+                            assert!(v.cmpge(c.min).all() && v.cmple(c.max).all());
+                        }
+                        (lo, hi) = (lo.min(v), hi.max(v));
                     }
+                }
+                if builder == BvhBuilder::Split && lo.is_finite() && hi.is_finite() {
+                    assert!(
+                        c.min.cmpge(lo).all() && c.max.cmple(hi).all(),
+                        "leaf box {} {} outside its triangles' box {lo} {hi}",
+                        c.min,
+                        c.max
+                    );
                 }
             } else {
                 stack.push((c.index, depth + 1, Some((c.min, c.max))));
@@ -768,4 +798,149 @@ fn parallel_build_is_deterministic_and_correct() {
         let d = rand_dir(&mut r);
         check_ray(&a, &tris, o, d, f32::INFINITY);
     }
+}
+
+/// Long thin triangles at random orientations (the kind early split clipping cuts).
+fn slivers(r: &mut Pcg64, n: usize, extent: f32) -> Vec<[Vec3; 3]> {
+    (0..n)
+        .map(|_| {
+            let a = rand_vec(r, -extent, extent);
+            let b = rand_vec(r, -extent, extent);
+            let e = rand_vec(r, -0.01 * extent, 0.01 * extent);
+            [a, b, a + e]
+        })
+        .collect()
+}
+
+#[test]
+fn split_pieces_cover_their_triangle() {
+    // Every point of a triangle must lie in the box of one of its pieces: otherwise a ray
+    // hitting it there never reaches its leaf.
+    let mut r = rng(21);
+    let mut tris = slivers(&mut r, 300, 50.0);
+    tris.extend(random_triangles(&mut r, 300, 1000.0, 300.0));
+    // Near the origin and far from it: the padding is relative to the coordinates.
+    tris.extend(slivers(&mut r, 100, 1e-3));
+    tris.extend(random_triangles(&mut r, 100, 1e6, 1e3));
+    let (prims, ids) = super::split::split_references(tris.len(), &|i| tris[i]);
+    assert_eq!(prims.len(), ids.len());
+    assert!(prims.len() > tris.len(), "nothing was split");
+    let mut pieces = vec![vec![]; tris.len()];
+    for (p, &i) in prims.iter().zip(&ids) {
+        pieces[i as usize].push(*p);
+    }
+    for (i, t) in tris.iter().enumerate() {
+        let box_lo = t[0].min(t[1]).min(t[2]);
+        let box_hi = t[0].max(t[1]).max(t[2]);
+        assert!(!pieces[i].is_empty() && pieces[i].len() <= 1 << super::split::SPLIT_DEPTH);
+        for p in &pieces[i] {
+            let (lo, hi) = (Vec3::from(p.lo), Vec3::from(p.hi));
+            assert!(
+                lo.cmpge(box_lo).all() && hi.cmple(box_hi).all(),
+                "piece outside its triangle's box"
+            );
+        }
+        // In f64, exactly on the triangle: its vertices, random interior and edge
+        // points, and where its edges cross every face plane of its pieces (the clip
+        // points, which the builder computed in rounded f32).
+        let t64 = t.map(|v| v.as_dvec3());
+        let mut points = t64.to_vec();
+        for _ in 0..100 {
+            let (u, v): (f64, f64) = (r.random(), r.random());
+            let (u, v) = if u + v > 1.0 {
+                (1.0 - u, 1.0 - v)
+            } else {
+                (u, v)
+            };
+            points.push(t64[0] + (t64[1] - t64[0]) * u + (t64[2] - t64[0]) * v);
+            points.push(t64[0] + (t64[2] - t64[0]) * u);
+        }
+        for p in &pieces[i] {
+            for axis in 0..3 {
+                for c in [p.lo[axis] as f64, p.hi[axis] as f64] {
+                    for k in 0..3 {
+                        let (a, b) = (t64[k], t64[(k + 1) % 3]);
+                        if (a[axis] - c) * (b[axis] - c) < 0.0 {
+                            points.push(a + (b - a) * ((c - a[axis]) / (b[axis] - a[axis])));
+                        }
+                    }
+                }
+            }
+        }
+        for q in points {
+            assert!(
+                pieces[i]
+                    .iter()
+                    .any(|p| q.cmpge(Vec3::from(p.lo).as_dvec3()).all()
+                        && q.cmple(Vec3::from(p.hi).as_dvec3()).all()),
+                "triangle {i}: point {q} in none of its {} pieces",
+                pieces[i].len()
+            );
+        }
+    }
+}
+
+#[test]
+fn split_build_answers_as_brute_force() {
+    for (seed, kind) in [(31u64, 0), (32, 1), (33, 2)] {
+        let mut r = rng(seed);
+        let mut tris = match kind {
+            0 => slivers(&mut r, 2000, 10.0),
+            1 => random_triangles(&mut r, 3000, 10.0, 2.0),
+            _ => {
+                // A few of everything, with degenerate and non-finite triangles.
+                let mut t = slivers(&mut r, 50, 10.0);
+                t.extend(random_triangles(&mut r, 50, 10.0, 4.0));
+                t.push([Vec3::ONE, Vec3::ONE, Vec3::ONE]);
+                t.push([Vec3::ZERO, Vec3::X * 5.0, Vec3::X * 9.0]);
+                t.push([Vec3::ZERO, Vec3::new(f32::NAN, 0.0, 0.0), Vec3::Y]);
+                t.push([Vec3::ZERO, Vec3::new(f32::INFINITY, 1.0, 0.0), Vec3::Y]);
+                t
+            }
+        };
+        tris.push([
+            Vec3::new(-9.0, -9.0, 0.5),
+            Vec3::new(9.0, 9.0, 0.5),
+            Vec3::new(9.0, 9.1, 0.5),
+        ]);
+        let bvh = Bvh::build_from_vertices_with(&tris, BvhBuilder::Split);
+        check_structure_of(&bvh, &tris, BvhBuilder::Split);
+        assert!(bvh.tri_order.len() > tris.len(), "nothing was split");
+        let mut hits = 0;
+        for k in 0..3000 {
+            let o = rand_vec(&mut r, -14.0, 14.0);
+            let (d, tmax) = match k % 3 {
+                0 => (rand_dir(&mut r), f32::INFINITY),
+                1 => (rand_dir(&mut r) * 3.7, 2.0),
+                _ => (rand_vec(&mut r, -14.0, 14.0) - o, 1.0),
+            };
+            hits += check_ray(&bvh, &tris, o, d, tmax);
+        }
+        assert!(hits > 100, "too few hits ({hits}) to mean anything");
+    }
+}
+
+#[test]
+fn split_build_tests_fewer_triangles_on_slivers() {
+    // What the builder is for: on long thin triangles, segments test fewer triangles (the
+    // walk's nodes may grow a little). Counted on the CPU twin, the GPU's walk.
+    let mut r = rng(41);
+    let tris = slivers(&mut r, 5000, 10.0);
+    let count = |bvh: &Bvh, r: &mut Pcg64| {
+        let (mut nodes, mut tests) = (0u64, 0u64);
+        for _ in 0..5000 {
+            let o = rand_vec(r, -10.0, 10.0);
+            let d = rand_vec(r, -10.0, 10.0) - o;
+            let (_, n, t) = traverse::trace_any_counted(bvh, o, d, 1.0);
+            (nodes, tests) = (nodes + n as u64, tests + t as u64);
+        }
+        (nodes, tests)
+    };
+    let binned = Bvh::build_from_vertices(&tris);
+    let split = Bvh::build_from_vertices_with(&tris, BvhBuilder::Split);
+    let (bn, bt) = count(&binned, &mut rng(42));
+    let (sn, st) = count(&split, &mut rng(42));
+    println!("binned: {bn} nodes, {bt} triangle tests; split: {sn} nodes, {st} triangle tests");
+    assert!(st * 2 < bt, "triangle tests {bt} -> {st}");
+    assert!(split.build_stats.sah_cost < binned.build_stats.sah_cost);
 }

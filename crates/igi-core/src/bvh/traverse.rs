@@ -499,3 +499,49 @@ pub fn shadow_segment(x: Vec3, nx: Vec3, y: Vec3, ny: Vec3, floor: f32) -> (Vec3
     let e = offset_ray_origin(y, ny, floor);
     (o, e - o)
 }
+
+/// [`trace_any`] counting its steps: (answer, nodes visited, triangles tested).
+#[cfg(test)]
+pub(crate) fn trace_any_counted(bvh: &Bvh, origin: Vec3, dir: Vec3, tmax: f32) -> (bool, u32, u32) {
+    let Some(r) = TraceRay::new(origin, dir) else {
+        return (false, 0, 0);
+    };
+    let (mut nodes, mut tris) = (0u32, 0u32);
+    let mut stack = [0u32; MAX_DEPTH as usize];
+    let mut sp = 0usize;
+    let mut node = 0u32;
+    loop {
+        nodes += 1;
+        let n = &bvh.nodes[node as usize];
+        let mut next = NO_HIT;
+        for (lo, hi, index, count, second) in [
+            (n.a_min, n.a_max, n.a_index, n.a_count, false),
+            (n.b_min, n.b_max, n.b_index, n.b_count, true),
+        ] {
+            if box_hit(lo, hi, &r, tmax) {
+                if count > 0 {
+                    for slot in index..index + count {
+                        tris += 1;
+                        if leaf_any(bvh, slot, 1, &r, tmax) {
+                            return (true, nodes, tris);
+                        }
+                    }
+                } else if next == NO_HIT {
+                    next = index;
+                } else {
+                    debug_assert!(second);
+                    stack[sp] = index;
+                    sp += 1;
+                }
+            }
+        }
+        if next == NO_HIT {
+            if sp == 0 {
+                return (false, nodes, tris);
+            }
+            sp -= 1;
+            next = stack[sp];
+        }
+        node = next;
+    }
+}

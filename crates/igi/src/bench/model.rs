@@ -83,6 +83,10 @@ pub struct ImageErrors {
     pub flip: f64,
 }
 
+fn binned() -> String {
+    igi_core::bvh::BvhBuilder::Binned.name().to_string()
+}
+
 /// One scene x set-up x VPL count.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct BenchRun {
@@ -92,6 +96,10 @@ pub struct BenchRun {
     pub triangles: u64,
     /// BVH build time on the CPU of the benchmarking machine.
     pub bvh_build_ms: f64,
+    /// The BVH builder (`--bvh`): "binned" or "split" (results written before it existed
+    /// were all "binned").
+    #[serde(default = "binned")]
+    pub bvh: String,
     pub width: u32,
     pub height: u32,
     /// Set-up name as given to --setups, e.g. "canonical", "iv", "iv+ds", "iv+ds+il".

@@ -317,8 +317,9 @@ pub fn to_markdown(results: &BenchResults) -> String {
         let first = sc.runs[0];
         let _ = writeln!(
             s,
-            "{} triangles (BVH built in {} ms), rendered at {}.\n",
+            "{} triangles ({} BVH built in {} ms), rendered at {}.\n",
             first.triangles,
+            first.bvh,
             sig3(first.bvh_build_ms),
             sizes.join(", ")
         );
@@ -980,6 +981,7 @@ mod tests {
             scene_path: format!("scenes/{scene}.toml"),
             triangles: 262_267,
             bvh_build_ms: 123.456,
+            bvh: "binned".to_string(),
             width: 800,
             height: 600,
             setup: setup.into(),

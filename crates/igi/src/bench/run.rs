@@ -33,6 +33,8 @@ pub struct BenchOptions {
     pub width: Option<u32>,
     pub height: Option<u32>,
     pub seed: u32,
+    /// BVH builder of every scene.
+    pub bvh: igi_core::bvh::BvhBuilder,
     pub adapter: Option<String>,
     pub quiet: bool,
     pub command: String,
@@ -190,7 +192,7 @@ pub fn run(opts: &BenchOptions) -> Result<BenchResults> {
         bar.set_message(format!("{name}: loading"));
         let scene = load(arg)?;
         let t = Instant::now();
-        let bvh = Bvh::build(&scene.triangles);
+        let bvh = Bvh::build_with(&scene.triangles, opts.bvh);
         let bvh_build_ms = t.elapsed().as_secs_f64() * 1e3;
         let mut renderer = Renderer::new(&ctx, &scene, &bvh)?;
         let reference_path = match &opts.reference {
@@ -301,6 +303,7 @@ pub fn run(opts: &BenchOptions) -> Result<BenchResults> {
                     scene_path: arg.clone(),
                     triangles: scene.triangles.len() as u64,
                     bvh_build_ms,
+                    bvh: opts.bvh.name().to_string(),
                     width: settings.width,
                     height: settings.height,
                     setup: setup.clone(),

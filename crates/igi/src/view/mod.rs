@@ -46,6 +46,7 @@ pub struct ViewOptions {
     pub max_accumulate: u32,
     pub render_scale: u32,
     pub show_vpls: bool,
+    pub bvh: igi_core::bvh::BvhBuilder,
     /// Initial inner size of the window, in physical pixels.
     pub window: (u32, u32),
 }
@@ -53,13 +54,13 @@ pub struct ViewOptions {
 /// Open the window and run until it is closed (or `frames` are done).
 pub fn run(opts: ViewOptions) -> Result<()> {
     let t = Instant::now();
-    let bvh = Bvh::build(&opts.scene.triangles);
+    let bvh = Bvh::build_with(&opts.scene.triangles, opts.bvh);
     eprintln!(
-        "scene {}: {} triangles, {} lights (BVH built in {:.1} ms)",
+        "scene {}: {} triangles, {} lights ({})",
         opts.scene.source,
         opts.scene.triangles.len(),
         opts.scene.lights.len(),
-        t.elapsed().as_secs_f64() * 1e3
+        crate::bvh_built(&bvh, opts.bvh, t.elapsed().as_secs_f64() * 1e3)
     );
     let event_loop = EventLoop::new().map_err(|e| {
         anyhow!("cannot open a window: {e} (no display: set DISPLAY or WAYLAND_DISPLAY, or run under xvfb-run)")

@@ -1,0 +1,189 @@
+//! Early split clipping (Ernst and Greiner, "Early Split Clipping for Bounding Volume
+//! Hierarchies", 2007): the references of [`BvhBuilder::Split`], igi's slower-to-build,
+//! faster-to-trace alternative to the binned build of whole triangles.
+//!
+//! A long thin triangle (the conference room's slivers) has a box far larger than
+//! itself: every ray through that box tests the triangle for nothing, and the boxes of
+//! the nodes above it overlap. Before the binned build, each triangle whose box's half
+//! area exceeds [`SPLIT_RATIO`] times its own area is cut in two at the middle of its
+//! box's longest axis, each piece (the triangle clipped to one half) keeping the box of
+//! that piece; pieces are cut again while they stay that much larger than their part of
+//! the triangle, at most [`SPLIT_DEPTH`] times. The builder then sees one reference per
+//! piece, each with its triangle's index: a triangle can sit in several leaves, and
+//! [`Bvh::tri_order`] repeats it.
+//!
+//! Answers do not change: a piece's box is padded outward by [`CLIP_PAD`] of the
+//! triangle's largest coordinate on each axis (several times the rounding of a clip
+//! point) and kept inside its parent's box, so every point of a triangle lies in some
+//! piece's box, and the triangle test (on the whole triangle) decides as before.
+//! Imperfect visibility (section 4.1 of the paper) does see a difference: it still tests
+//! the whole triangle's box, but a segment reaches that test only through a leaf whose
+//! piece box it enters, so it finds less false occlusion (docs/PERFORMANCE.md, attempt
+//! 77).
+
+use glam::{Vec3, Vec3A};
+
+use super::build::{par_chunks, Aabb, PrimRef};
+#[cfg(doc)]
+use super::{Bvh, BvhBuilder};
+
+/// A triangle's reference is split while its box's half area exceeds this many times
+/// the area of the triangle's part in it. With [`SPLIT_DEPTH`], the best of the ratio
+/// and depth pairs measured on the H200 (4/2, 8/3, 4/3, 16/4; docs/PERFORMANCE.md
+/// attempt 77).
+pub const SPLIT_RATIO: f32 = 4.0;
+
+/// At most this many halvings per triangle: up to 2^SPLIT_DEPTH references.
+pub const SPLIT_DEPTH: u32 = 2;
+
+/// Outward padding of a piece's box, relative to the triangle's largest coordinate on
+/// each axis: 2^-19, 16 ulps of that coordinate, several times the error of a clip point
+/// p + (q - p) t.
+const CLIP_PAD: f32 = 1.0 / 524_288.0;
+
+/// Vertices a piece can have: a triangle gains at most one per cut.
+const MAX_POLY: usize = 3 + SPLIT_DEPTH as usize;
+
+/// A convex polygon: a triangle or the piece of one that a few cuts left.
+#[derive(Clone, Copy)]
+struct Poly {
+    v: [Vec3A; MAX_POLY],
+    n: usize,
+}
+
+impl Poly {
+    fn area(&self) -> f32 {
+        let mut s = Vec3A::ZERO;
+        for i in 1..self.n.saturating_sub(1) {
+            s += (self.v[i] - self.v[0]).cross(self.v[i + 1] - self.v[0]);
+        }
+        0.5 * s.length()
+    }
+
+    /// The parts of the polygon on either side of the plane x[axis] = at.
+    fn cut(&self, axis: usize, at: f32) -> (Poly, Poly) {
+        let empty = Poly {
+            v: [Vec3A::ZERO; MAX_POLY],
+            n: 0,
+        };
+        let (mut lo, mut hi) = (empty, empty);
+        let push = |p: &mut Poly, x: Vec3A| {
+            if p.n < MAX_POLY {
+                p.v[p.n] = x;
+                p.n += 1;
+            }
+        };
+        for i in 0..self.n {
+            let (p, q) = (self.v[i], self.v[(i + 1) % self.n]);
+            let (dp, dq) = (p[axis] - at, q[axis] - at);
+            if dp <= 0.0 {
+                push(&mut lo, p);
+            }
+            if dp >= 0.0 {
+                push(&mut hi, p);
+            }
+            if (dp < 0.0 && dq > 0.0) || (dp > 0.0 && dq < 0.0) {
+                let mut x = p + (q - p) * (dp / (dp - dq));
+                x[axis] = at;
+                push(&mut lo, x);
+                push(&mut hi, x);
+            }
+        }
+        (lo, hi)
+    }
+
+    fn bounds(&self) -> Aabb {
+        let mut b = Aabb::EMPTY;
+        for &p in &self.v[..self.n] {
+            b.grow_point(p);
+        }
+        b
+    }
+}
+
+/// The references of `count` triangles with early split clipping: (boxes, triangle
+/// index of each), in triangle order, the same on any number of threads.
+pub(super) fn split_references<F>(count: usize, tri: &F) -> (Vec<PrimRef>, Vec<u32>)
+where
+    F: Fn(usize) -> [Vec3; 3] + Sync,
+{
+    let mut order: Vec<u32> = (0..count as u32).collect();
+    let parts = par_chunks(&mut order, 1, |_, chunk| {
+        let (mut prims, mut ids) = (
+            Vec::with_capacity(chunk.len()),
+            Vec::with_capacity(chunk.len()),
+        );
+        for &i in chunk.iter() {
+            let before = prims.len();
+            references_of(tri(i as usize), &mut prims);
+            ids.extend(std::iter::repeat_n(i, prims.len() - before));
+        }
+        (prims, ids)
+    });
+    let total = parts.iter().map(|p| p.0.len()).sum();
+    let (mut prims, mut ids) = (Vec::with_capacity(total), Vec::with_capacity(total));
+    for (p, i) in parts {
+        prims.extend(p);
+        ids.extend(i);
+    }
+    (prims, ids)
+}
+
+/// Appends the references of one triangle.
+fn references_of(t: [Vec3; 3], out: &mut Vec<PrimRef>) {
+    let v = t.map(Vec3A::from);
+    let (lo, hi) = (v[0].min(v[1]).min(v[2]), v[0].max(v[1]).max(v[2]));
+    // As in the plain build: a triangle with a non-finite vertex gets a point box at the
+    // origin and is never split.
+    if !(lo.is_finite() && hi.is_finite()) {
+        out.push(PrimRef {
+            lo: Vec3A::ZERO,
+            hi: Vec3A::ZERO,
+        });
+        return;
+    }
+    let pad = v[0].abs().max(v[1].abs()).max(v[2].abs()) * CLIP_PAD;
+    let mut poly = Poly {
+        v: [Vec3A::ZERO; MAX_POLY],
+        n: 3,
+    };
+    poly.v[..3].copy_from_slice(&v);
+    split_piece(&poly, Aabb { lo, hi }, pad, SPLIT_DEPTH, out);
+}
+
+/// Appends the references of one piece whose (padded) box is `b`.
+fn split_piece(poly: &Poly, b: Aabb, pad: Vec3A, depth: u32, out: &mut Vec<PrimRef>) {
+    if depth == 0 || poly.n < 3 || b.half_area() <= SPLIT_RATIO * poly.area() {
+        out.push(PrimRef { lo: b.lo, hi: b.hi });
+        return;
+    }
+    let e = b.hi - b.lo;
+    let axis = if e.x >= e.y && e.x >= e.z {
+        0
+    } else if e.y >= e.z {
+        1
+    } else {
+        2
+    };
+    let at = 0.5 * (b.lo[axis] + b.hi[axis]);
+    let (lo_part, hi_part) = poly.cut(axis, at);
+    for (part, below) in [(lo_part, true), (hi_part, false)] {
+        if part.n < 3 {
+            // The piece only touches the plane: the other side holds all of it.
+            continue;
+        }
+        let tight = part.bounds();
+        let (mut plo, mut phi) = (tight.lo - pad, tight.hi + pad);
+        // Never past the cut: the clip points lie on the plane itself.
+        if below {
+            phi[axis] = phi[axis].min(at);
+        } else {
+            plo[axis] = plo[axis].max(at);
+        }
+        let piece = Aabb {
+            lo: plo.max(b.lo),
+            hi: phi.min(b.hi),
+        };
+        split_piece(&part, piece, pad, depth - 1, out);
+    }
+}
