@@ -260,17 +260,23 @@ fn bench_rays_saves_and_loads_the_same_rays() {
         String::from_utf8_lossy(&first.stderr)
     );
     assert_eq!(std::fs::metadata(&file).unwrap().len(), 4096 * 32);
-    let second = igi(&[
-        "bench",
-        "rays",
-        "builtin:cornell-box",
-        "--kind",
-        "shadow",
-        "--runs",
-        "1",
-        "--load",
-        file.to_str().unwrap(),
-    ]);
+    // The saved rays traced again, with the given BVH builder.
+    let load = |bvh: &str| {
+        igi(&[
+            "bench",
+            "rays",
+            "builtin:cornell-box",
+            "--kind",
+            "shadow",
+            "--runs",
+            "1",
+            "--bvh",
+            bvh,
+            "--load",
+            file.to_str().unwrap(),
+        ])
+    };
+    let second = load("binned");
     assert!(second.status.success());
     // The same rays give the same occluded fraction.
     let fraction = |o: &Output| {
@@ -279,19 +285,7 @@ fn bench_rays_saves_and_loads_the_same_rays() {
     };
     assert_eq!(fraction(&first), fraction(&second));
     // The split BVH (early split clipping) gives every any-hit answer the same.
-    let split = igi(&[
-        "bench",
-        "rays",
-        "builtin:cornell-box",
-        "--kind",
-        "shadow",
-        "--runs",
-        "1",
-        "--bvh",
-        "split",
-        "--load",
-        file.to_str().unwrap(),
-    ]);
+    let split = load("split");
     assert!(split.status.success());
     assert!(String::from_utf8_lossy(&split.stderr).contains("split BVH of"));
     let hash = |o: &Output| {
