@@ -3,20 +3,24 @@
 //! and SAH cost, and a CPU traversal sanity figure.
 //!
 //! `cargo run --release -p igi-core --example bvh_build -- [SCENE.toml|MESH.obj] [RUNS]
-//! [--splits]` (default: the conference room of `shared/scenes`, 5 runs; `--splits`
-//! measures `BvhBuilder::Split`, early split clipping). An OBJ is read as bare
+//! [--binned]` (default: the conference room of `shared/scenes`, 5 runs, the commands'
+//! default builder `BvhBuilder::Split`; `--binned` measures `BvhBuilder::Binned`). An OBJ is read as bare
 //! triangles with `tobj`, every face kept (the scene loader may drop degenerate ones).
 
 use std::path::PathBuf;
 use std::time::Instant;
 
-use igi_core::bvh::Bvh;
+use igi_core::bvh::{Bvh, BvhBuilder};
 use igi_core::scene::{load_scene, Triangle};
 use igi_core::Vec3;
 
 fn main() {
-    let splits = std::env::args().any(|a| a == "--splits");
-    let mut args = std::env::args().skip(1).filter(|a| a != "--splits");
+    let builder = if std::env::args().any(|a| a == "--binned") {
+        BvhBuilder::Binned
+    } else {
+        BvhBuilder::Split
+    };
+    let mut args = std::env::args().skip(1).filter(|a| a != "--binned");
     let path = PathBuf::from(
         args.next()
             .unwrap_or_else(|| "/work/shared/scenes/conference/scene.toml".to_string()),
@@ -45,6 +49,7 @@ fn main() {
         triangles.len(),
         t.elapsed().as_secs_f64() * 1e3
     );
+    println!("builder: {}", builder.name());
     println!(
         "threads: {}",
         std::thread::available_parallelism().map_or(1, |n| n.get())
@@ -55,11 +60,7 @@ fn main() {
     let cpu_start = process_cpu_seconds();
     for _ in 0..runs {
         let t = Instant::now();
-        let b = if splits {
-            Bvh::build_with(&triangles, igi_core::bvh::BvhBuilder::Split)
-        } else {
-            Bvh::build(&triangles)
-        };
+        let b = Bvh::build_with(&triangles, builder);
         times.push(t.elapsed().as_secs_f64() * 1e3);
         bvh = Some(b);
     }

@@ -158,16 +158,19 @@ impl BvhNode {
 /// Which builder makes a [`Bvh`].
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum BvhBuilder {
-    /// Binned SAH over whole triangles (the `build` submodule): the fast build.
+    /// Binned SAH over references with early split clipping (the `split` submodule:
+    /// Ernst and Greiner 2007): the few long thin triangles whose boxes waste the most
+    /// area are cut into pieces with tighter boxes. On the conference room 17% more
+    /// references and about 1.3 times the build time of `Binned`, and every ray query
+    /// and frame faster on the H200 (docs/PERFORMANCE.md, attempts 77 and 79). Every
+    /// exact query answers as with `Binned` (closest-hit ties between triangles at one
+    /// distance aside); imperfect visibility finds less false occlusion. The commands'
+    /// default.
     #[default]
-    Binned,
-    /// The same over references with early split clipping (the `split` submodule: Ernst
-    /// and Greiner 2007): long thin triangles are cut into pieces with tighter boxes.
-    /// About twice the references and the build time on the conference room, and a
-    /// faster walk (docs/PERFORMANCE.md, attempt 77). Every exact query answers as with
-    /// `Binned` (closest-hit ties between triangles at one distance aside); imperfect
-    /// visibility finds less false occlusion.
     Split,
+    /// Binned SAH over whole triangles (the `build` submodule, [`Bvh::build`]): the
+    /// fastest build.
+    Binned,
 }
 
 impl BvhBuilder {

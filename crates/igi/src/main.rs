@@ -110,9 +110,9 @@ struct RaysArgs {
     height: Option<u32>,
     #[arg(long, default_value_t = 0)]
     seed: u32,
-    /// BVH builder: binned (fast build) or split (early split clipping: about twice the
-    /// build time, a faster walk on scenes of long thin triangles).
-    #[arg(long, value_enum, default_value = "binned")]
+    /// BVH builder: split (early split clipping of long thin triangles: a faster walk)
+    /// or binned (whole triangles: a faster build).
+    #[arg(long, value_enum, default_value = "split")]
     bvh: BvhArg,
     /// Adapter: an index or part of a name from `igi info`.
     #[arg(long)]
@@ -155,9 +155,9 @@ struct BenchArgs {
     height: Option<u32>,
     #[arg(long, default_value_t = 0)]
     seed: u32,
-    /// BVH builder: binned (fast build) or split (early split clipping: about twice the
-    /// build time, a faster walk on scenes of long thin triangles).
-    #[arg(long, value_enum, default_value = "binned")]
+    /// BVH builder: split (early split clipping of long thin triangles: a faster walk)
+    /// or binned (whole triangles: a faster build).
+    #[arg(long, value_enum, default_value = "split")]
     bvh: BvhArg,
     /// Adapter: an index or part of a name from `igi info`.
     #[arg(long)]
@@ -169,10 +169,10 @@ struct BenchArgs {
 
 #[derive(Clone, Copy, ValueEnum)]
 enum BvhArg {
-    /// Binned SAH over whole triangles.
-    Binned,
     /// Binned SAH with early split clipping of long thin triangles.
     Split,
+    /// Binned SAH over whole triangles.
+    Binned,
 }
 
 impl From<BvhArg> for BvhBuilder {
@@ -245,9 +245,9 @@ struct FrameArgs {
     /// Seed of the VPL set (a window of the Halton sequence).
     #[arg(long, default_value_t = 0)]
     seed: u32,
-    /// BVH builder: binned (fast build) or split (early split clipping: about twice the
-    /// build time, a faster walk on scenes of long thin triangles).
-    #[arg(long, value_enum, default_value = "binned")]
+    /// BVH builder: split (early split clipping of long thin triangles: a faster walk)
+    /// or binned (whole triangles: a faster build).
+    #[arg(long, value_enum, default_value = "split")]
     bvh: BvhArg,
     /// Adapter to use: an index or part of a name from `igi info` (default: the best).
     #[arg(long)]

@@ -95,7 +95,7 @@ pub(super) struct PrimRef {
 
 impl PrimRef {
     #[inline]
-    fn centroid2(&self) -> Vec3A {
+    pub(super) fn centroid2(&self) -> Vec3A {
         self.lo + self.hi
     }
 }
@@ -342,14 +342,11 @@ where
         };
     }
 
-    let (mut prims, mut ids, bounds, cbounds) = if limits.split {
-        let (prims, ids) = super::split::split_references(count, &tri);
-        let (bounds, cbounds) = range_bounds(&prims);
-        (prims, ids, bounds, cbounds)
-    } else {
-        let (prims, bounds, cbounds) = whole_references(count, &tri);
-        (prims, (0..count as u32).collect(), bounds, cbounds)
-    };
+    let (mut prims, bounds, mut cbounds) = whole_references(count, &tri);
+    let mut ids: Vec<u32> = (0..count as u32).collect();
+    if limits.split {
+        cbounds = super::split::split_references(&mut prims, &mut ids, &bounds, &tri);
+    }
     // References: one per triangle, or more with early split clipping.
     let refs = prims.len();
     assert!(
@@ -423,7 +420,7 @@ where
 }
 
 /// One reference per triangle, its box: (boxes, box of all, box of the doubled centroids).
-fn whole_references<F>(count: usize, tri: &F) -> (Vec<PrimRef>, Aabb, Aabb)
+pub(super) fn whole_references<F>(count: usize, tri: &F) -> (Vec<PrimRef>, Aabb, Aabb)
 where
     F: Fn(usize) -> [Vec3; 3] + Sync,
 {

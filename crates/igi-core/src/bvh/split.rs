@@ -4,11 +4,12 @@
 //!
 //! A long thin triangle (the conference room's slivers) has a box far larger than
 //! itself: every ray through that box tests the triangle for nothing, and the boxes of
-//! the nodes above it overlap. Before the binned build, each triangle whose box's half
-//! area exceeds [`SPLIT_RATIO`] times its own area is cut in two at the middle of its
+//! the nodes above it overlap. Before the binned build, each triangle whose box wastes
+//! area (its half area exceeds [`SPLIT_RATIO`] times the triangle's area, by more than
+//! [`SPLIT_MIN_WASTE`] of the scene box's half area) is cut in two at the middle of its
 //! box's longest axis, each piece (the triangle clipped to one half) keeping the box of
-//! that piece; pieces are cut again while they stay that much larger than their part of
-//! the triangle, at most [`SPLIT_DEPTH`] times. The builder then sees one reference per
+//! that piece; pieces are cut again while they still waste that much, at most
+//! [`SPLIT_DEPTH`] times. The builder then sees one reference per
 //! piece, each with its triangle's index: a triangle can sit in several leaves, and
 //! [`Bvh::tri_order`] repeats it.
 //!
@@ -29,12 +30,19 @@ use super::{Bvh, BvhBuilder};
 
 /// A triangle's reference is split while its box's half area exceeds this many times
 /// the area of the triangle's part in it. With [`SPLIT_DEPTH`], the best of the ratio
-/// and depth pairs measured on the H200 (4/2, 8/3, 4/3, 16/4; docs/PERFORMANCE.md
-/// attempt 77).
+/// and depth pairs measured on the H200 (4/2, 8/3, 4/3, 16/4 in docs/PERFORMANCE.md
+/// attempt 77; with [`SPLIT_MIN_WASTE`], 4/2 against 4/3 and 4/4 in attempt 79).
 pub const SPLIT_RATIO: f32 = 4.0;
 
 /// At most this many halvings per triangle: up to 2^SPLIT_DEPTH references.
 pub const SPLIT_DEPTH: u32 = 2;
+
+/// Only a box that wastes more than this fraction of the scene box's half area is cut:
+/// small slivers are many and cost rays little. On the conference room, 323,506
+/// references (+17%) instead of 566,924 with the ratio alone, and every GPU figure
+/// better (docs/PERFORMANCE.md attempt 79); relative to the scene's box, so that the
+/// cut does not depend on the scene's units.
+pub const SPLIT_MIN_WASTE: f32 = 1e-6;
 
 /// Outward padding of a piece's box, relative to the triangle's largest coordinate on
 /// each axis: 2^-19, 16 ulps of that coordinate, several times the error of a clip point
@@ -101,45 +109,61 @@ impl Poly {
     }
 }
 
-/// The references of `count` triangles with early split clipping: (boxes, triangle
-/// index of each), in triangle order, the same on any number of threads.
-pub(super) fn split_references<F>(count: usize, tri: &F) -> (Vec<PrimRef>, Vec<u32>)
+/// Early split clipping of the references of whole triangles (`prims[i]`: the box of
+/// triangle i, `bounds`: the box of them all): a triangle that is cut keeps its first
+/// piece in its own slot and appends the others, with its index, to `prims` and `ids`.
+/// Returns the new box of the doubled centroids. The same on any number of threads:
+/// the appended pieces come in triangle order.
+pub(super) fn split_references<F>(
+    prims: &mut Vec<PrimRef>,
+    ids: &mut Vec<u32>,
+    bounds: &Aabb,
+    tri: &F,
+) -> Aabb
 where
     F: Fn(usize) -> [Vec3; 3] + Sync,
 {
-    let mut order: Vec<u32> = (0..count as u32).collect();
-    let parts = par_chunks(&mut order, 1, |_, chunk| {
-        let (mut prims, mut ids) = (
-            Vec::with_capacity(chunk.len()),
-            Vec::with_capacity(chunk.len()),
-        );
-        for &i in chunk.iter() {
-            let before = prims.len();
-            references_of(tri(i as usize), &mut prims);
-            ids.extend(std::iter::repeat_n(i, prims.len() - before));
+    let min_waste = SPLIT_MIN_WASTE * bounds.half_area();
+    let parts = par_chunks(prims, 1, |start, chunk| {
+        let (mut more, mut more_ids) = (vec![], vec![]);
+        let mut pieces = vec![];
+        let mut cbounds = Aabb::EMPTY;
+        for (k, p) in chunk.iter_mut().enumerate() {
+            // Cheap test first: a box cannot waste more than its own half area (most
+            // triangles stop here, without reading their vertices).
+            let b = Aabb { lo: p.lo, hi: p.hi };
+            if b.half_area() > min_waste {
+                let i = start + k;
+                pieces.clear();
+                references_of(tri(i), b, min_waste, &mut pieces);
+                *p = pieces[0];
+                more.extend_from_slice(&pieces[1..]);
+                more_ids.extend(std::iter::repeat_n(i as u32, pieces.len() - 1));
+            }
+            cbounds.grow_point(p.centroid2());
         }
-        (prims, ids)
+        for p in &more {
+            cbounds.grow_point(p.centroid2());
+        }
+        (more, more_ids, cbounds)
     });
-    let total = parts.iter().map(|p| p.0.len()).sum();
-    let (mut prims, mut ids) = (Vec::with_capacity(total), Vec::with_capacity(total));
-    for (p, i) in parts {
-        prims.extend(p);
-        ids.extend(i);
+    let mut cbounds = Aabb::EMPTY;
+    for (more, more_ids, c) in parts {
+        prims.extend(more);
+        ids.extend(more_ids);
+        cbounds.grow(&c);
     }
-    (prims, ids)
+    cbounds
 }
 
-/// Appends the references of one triangle.
-fn references_of(t: [Vec3; 3], out: &mut Vec<PrimRef>) {
+/// Appends the references of one triangle whose box `b` is that of its finite vertices
+/// (`min_waste`: the half area a box must waste to be cut, see [`SPLIT_MIN_WASTE`]).
+fn references_of(t: [Vec3; 3], b: Aabb, min_waste: f32, out: &mut Vec<PrimRef>) {
     let v = t.map(Vec3A::from);
-    let (lo, hi) = (v[0].min(v[1]).min(v[2]), v[0].max(v[1]).max(v[2]));
-    // As in the plain build: a triangle with a non-finite vertex gets a point box at the
-    // origin and is never split.
-    if !(lo.is_finite() && hi.is_finite()) {
-        out.push(PrimRef {
-            lo: Vec3A::ZERO,
-            hi: Vec3A::ZERO,
-        });
+    // A triangle with a non-finite vertex has a point box at the origin (see `build`)
+    // and is never cut.
+    if !(v[0].is_finite() && v[1].is_finite() && v[2].is_finite()) {
+        out.push(PrimRef { lo: b.lo, hi: b.hi });
         return;
     }
     let pad = v[0].abs().max(v[1].abs()).max(v[2].abs()) * CLIP_PAD;
@@ -148,12 +172,20 @@ fn references_of(t: [Vec3; 3], out: &mut Vec<PrimRef>) {
         n: 3,
     };
     poly.v[..3].copy_from_slice(&v);
-    split_piece(&poly, Aabb { lo, hi }, pad, SPLIT_DEPTH, out);
+    split_piece(&poly, b, pad, min_waste, SPLIT_DEPTH, out);
 }
 
 /// Appends the references of one piece whose (padded) box is `b`.
-fn split_piece(poly: &Poly, b: Aabb, pad: Vec3A, depth: u32, out: &mut Vec<PrimRef>) {
-    if depth == 0 || poly.n < 3 || b.half_area() <= SPLIT_RATIO * poly.area() {
+fn split_piece(
+    poly: &Poly,
+    b: Aabb,
+    pad: Vec3A,
+    min_waste: f32,
+    depth: u32,
+    out: &mut Vec<PrimRef>,
+) {
+    let waste = b.half_area() - SPLIT_RATIO * poly.area();
+    if depth == 0 || poly.n < 3 || !(waste > 0.0 && waste > min_waste) {
         out.push(PrimRef { lo: b.lo, hi: b.hi });
         return;
     }
@@ -167,11 +199,13 @@ fn split_piece(poly: &Poly, b: Aabb, pad: Vec3A, depth: u32, out: &mut Vec<PrimR
     };
     let at = 0.5 * (b.lo[axis] + b.hi[axis]);
     let (lo_part, hi_part) = poly.cut(axis, at);
+    if lo_part.n < 3 || hi_part.n < 3 {
+        // The piece only touches the plane in rounded arithmetic, but the triangle may
+        // still reach past it by less than a rounding error: keep the piece whole.
+        out.push(PrimRef { lo: b.lo, hi: b.hi });
+        return;
+    }
     for (part, below) in [(lo_part, true), (hi_part, false)] {
-        if part.n < 3 {
-            // The piece only touches the plane: the other side holds all of it.
-            continue;
-        }
         let tight = part.bounds();
         let (mut plo, mut phi) = (tight.lo - pad, tight.hi + pad);
         // Never past the cut: the clip points lie on the plane itself.
@@ -184,6 +218,6 @@ fn split_piece(poly: &Poly, b: Aabb, pad: Vec3A, depth: u32, out: &mut Vec<PrimR
             lo: plo.max(b.lo),
             hi: phi.min(b.hi),
         };
-        split_piece(&part, piece, pad, depth - 1, out);
+        split_piece(&part, piece, pad, min_waste, depth - 1, out);
     }
 }

@@ -817,12 +817,27 @@ fn split_pieces_cover_their_triangle() {
     // Every point of a triangle must lie in the box of one of its pieces: otherwise a ray
     // hitting it there never reaches its leaf.
     let mut r = rng(21);
-    let mut tris = slivers(&mut r, 300, 50.0);
-    tris.extend(random_triangles(&mut r, 300, 1000.0, 300.0));
-    // Near the origin and far from it: the padding is relative to the coordinates.
-    tris.extend(slivers(&mut r, 100, 1e-3));
-    tris.extend(random_triangles(&mut r, 100, 1e6, 1e3));
-    let (prims, ids) = super::split::split_references(tris.len(), &|i| tris[i]);
+    let far = Vec3::new(1e6, -3e5, 2e5);
+    let groups = [
+        slivers(&mut r, 300, 50.0),
+        random_triangles(&mut r, 300, 1000.0, 300.0),
+        // Near the origin and far from it: the padding is relative to the coordinates.
+        slivers(&mut r, 100, 1e-3),
+        slivers(&mut r, 300, 10.0)
+            .into_iter()
+            .map(|t| t.map(|v| v + far))
+            .collect(),
+    ];
+    for tris in &groups {
+        check_pieces(tris, &mut r);
+    }
+}
+
+fn check_pieces(tris: &[[Vec3; 3]], r: &mut Pcg64) {
+    let tri = |i: usize| tris[i];
+    let (mut prims, bounds, _) = super::build::whole_references(tris.len(), &tri);
+    let mut ids: Vec<u32> = (0..tris.len() as u32).collect();
+    super::split::split_references(&mut prims, &mut ids, &bounds, &tri);
     assert_eq!(prims.len(), ids.len());
     assert!(prims.len() > tris.len(), "nothing was split");
     let mut pieces = vec![vec![]; tris.len()];
@@ -873,8 +888,8 @@ fn split_pieces_cover_their_triangle() {
                     .iter()
                     .any(|p| q.cmpge(Vec3::from(p.lo).as_dvec3()).all()
                         && q.cmple(Vec3::from(p.hi).as_dvec3()).all()),
-                "triangle {i}: point {q} in none of its {} pieces",
-                pieces[i].len()
+                "triangle {i} {t:?}: point {q} in none of its pieces {:?}",
+                pieces[i]
             );
         }
     }
