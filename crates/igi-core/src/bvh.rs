@@ -6,6 +6,8 @@
 //! paper's frame: closest hit (camera, mirror and particle rays) and any hit (shadow rays).
 //!
 //! * `build`: binned SAH (Wald 2007 style) over triangle centroids, built in parallel.
+//! * `split`: early split clipping (Ernst and Greiner 2007) of the triangles whose boxes
+//!   waste the most area, before the binned build ([`BvhBuilder::Split`]).
 //! * `traverse`: ray setup, the robust ray-box slab test (Ize, "Robust BVH Ray
 //!   Traversal", JCGT 2013), the watertight ray-triangle test (Woop, Benthin and Wald,
 //!   JCGT 2013), closest-hit and any-hit traversal, brute-force references, and the ray
@@ -211,9 +213,10 @@ pub struct BuildStats {
 pub struct Bvh {
     /// Interior nodes; node 0 is the root.
     pub nodes: Vec<BvhNode>,
-    /// Three vertices per triangle (xyz, w = 0), in BVH order (slot i at 3i..3i+3).
+    /// Three vertices per BVH slot (xyz, w = 0), in BVH order (slot i at 3i..3i+3).
     pub tri_verts: Vec<[f32; 4]>,
-    /// BVH slot -> index of the triangle in the slice given to [`Bvh::build`].
+    /// BVH slot -> index of the triangle in the slice given to the build. Each triangle
+    /// has one slot, or more with [`BvhBuilder::Split`] (one per piece).
     pub tri_order: Vec<u32>,
     pub build_stats: BuildStats,
 }
@@ -250,7 +253,7 @@ impl Bvh {
         build::build_from_vertices(triangles)
     }
 
-    /// Number of triangles (BVH slots).
+    /// Number of BVH slots: the triangles, and their repeats with [`BvhBuilder::Split`].
     pub fn triangle_count(&self) -> usize {
         self.tri_order.len()
     }

@@ -21,6 +21,10 @@
 //! built ([`rotate_locally`]), which lowers the SAH cost where the greedy splits left
 //! room; then the nodes are laid out depth first again, child a's subtree right after its
 //! parent.
+//!
+//! With [`super::BvhBuilder::Split`] the references are not whole triangles but the
+//! pieces that early split clipping (`split`) cut the wasteful ones into; the build is
+//! the same.
 
 use std::time::Instant;
 
@@ -75,7 +79,7 @@ impl Aabb {
         e.x * e.y + e.y * e.z + e.z * e.x
     }
 
-    pub(super) fn child(&self, index: u32, count: u32) -> BvhChild {
+    fn child(&self, index: u32, count: u32) -> BvhChild {
         BvhChild {
             min: self.lo.into(),
             max: self.hi.into(),
@@ -215,7 +219,7 @@ pub(super) fn build_from_vertices(triangles: &[[Vec3; 3]]) -> Bvh {
     )
 }
 
-/// With early split clipping of the references (`split`), any depth cap (tests).
+/// With early split clipping of the references (`split`): [`super::BvhBuilder::Split`].
 pub(super) fn build_split<F>(count: usize, tri: F, max_depth: u32) -> Bvh
 where
     F: Fn(usize) -> [Vec3; 3] + Sync,
@@ -262,7 +266,7 @@ pub(super) fn build_with_rotations(triangles: &[[Vec3; 3]], max_depth: u32, budg
     )
 }
 
-pub(super) fn threads() -> usize {
+fn threads() -> usize {
     std::thread::available_parallelism()
         .map(|n| n.get())
         .unwrap_or(1)
@@ -299,7 +303,7 @@ where
 
 /// Counts and areas gathered while building, for [`BuildStats`].
 #[derive(Default)]
-pub(super) struct Tally {
+struct Tally {
     leaves: usize,
     max_leaf_size: u32,
     oversized_leaves: usize,
@@ -308,14 +312,14 @@ pub(super) struct Tally {
 }
 
 impl Tally {
-    pub(super) fn leaf(&mut self, count: usize, half_area: f32) {
+    fn leaf(&mut self, count: usize, half_area: f32) {
         self.leaves += 1;
         self.max_leaf_size = self.max_leaf_size.max(count as u32);
         self.oversized_leaves += usize::from(count > MAX_LEAF_SIZE);
         self.leaf_area += (half_area * count as f32) as f64;
     }
 
-    pub(super) fn merge(&mut self, o: Tally) {
+    fn merge(&mut self, o: Tally) {
         self.leaves += o.leaves;
         self.max_leaf_size = self.max_leaf_size.max(o.max_leaf_size);
         self.oversized_leaves += o.oversized_leaves;
@@ -602,7 +606,7 @@ fn rotate_node(tree: &mut Region, i: usize, depth: u32, max_depth: u32) -> Optio
 /// One walk that writes each node at its new index and patches its parent's
 /// reference to it: on the conference room, 3.9-4.5 ms of the 2-core machine, against
 /// 9.3-10.7 ms for the three passes it replaced (list the order, renumber, sum).
-pub(super) fn depth_first_layout(nodes: &[BvhNode], interior: usize) -> (Vec<BvhNode>, f64, u32) {
+fn depth_first_layout(nodes: &[BvhNode], interior: usize) -> (Vec<BvhNode>, f64, u32) {
     let mut out: Vec<BvhNode> = Vec::with_capacity(interior);
     let (mut interior_area, mut deepest) = (0.0f64, 0u32);
     // (node, its parent's new index and side (0: a, 1: b), its depth); the root has no parent.
@@ -642,7 +646,7 @@ pub(super) fn depth_first_layout(nodes: &[BvhNode], interior: usize) -> (Vec<Bvh
 /// step), and the larger box is the one a ray more likely hits (the SAH's own estimate),
 /// so an occluder tends to be found sooner. Frame shadow rays ran 9% faster, random
 /// segments 15% (docs/PERFORMANCE.md, attempt 41). Ties keep the given order.
-pub(super) fn larger_first(a: BvhChild, b: BvhChild) -> BvhNode {
+fn larger_first(a: BvhChild, b: BvhChild) -> BvhNode {
     if b.half_area() > a.half_area() {
         BvhNode::new(b, a)
     } else {
@@ -1029,7 +1033,7 @@ fn partition_on<const AXIS: usize>(
     }
 }
 
-pub(super) fn stats(
+fn stats(
     triangles: usize,
     references: usize,
     nodes: usize,

@@ -9,9 +9,9 @@
 //! [`SPLIT_MIN_WASTE`] of the scene box's half area) is cut in two at the middle of its
 //! box's longest axis, each piece (the triangle clipped to one half) keeping the box of
 //! that piece; pieces are cut again while they still waste that much, at most
-//! [`SPLIT_DEPTH`] times. The builder then sees one reference per
-//! piece, each with its triangle's index: a triangle can sit in several leaves, and
-//! [`Bvh::tri_order`] repeats it.
+//! [`SPLIT_DEPTH`] times. The builder then sees one reference per piece, each with its
+//! triangle's index: a triangle can sit in several leaves, and [`Bvh::tri_order`]
+//! repeats it.
 //!
 //! Answers do not change: a piece's box is padded outward by [`CLIP_PAD`] of the
 //! triangle's largest coordinate on each axis (several times the rounding of a clip
@@ -19,8 +19,8 @@
 //! piece's box, and the triangle test (on the whole triangle) decides as before.
 //! Imperfect visibility (section 4.1 of the paper) does see a difference: it still tests
 //! the whole triangle's box, but a segment reaches that test only through a leaf whose
-//! piece box it enters, so it finds less false occlusion (docs/PERFORMANCE.md, attempt
-//! 77).
+//! piece box it enters, so it finds less false occlusion (docs/PERFORMANCE.md, attempts
+//! 77 and 79).
 
 use glam::{Vec3, Vec3A};
 
