@@ -15,12 +15,12 @@
 //! The two subtrees of the top levels are built on separate threads (`std::thread::scope`);
 //! each thread writes its own node list, appended and re-indexed after the join, so nodes
 //! stay in depth-first order (left subtree before right, children after their parent)
-//! whatever the thread count: the result does not depend on the machine. In each node the
-//! child of larger surface area is child a, which any-hit walks visit first; it need not
-//! be the left one. Each node makes Kensler's tree rotations as soon as its subtree is
-//! built ([`rotate_locally`]), which lowers the SAH cost where the greedy splits left
-//! room; then the nodes are laid out depth first again, child a's subtree right after its
-//! parent.
+//! whatever the thread count: the result does not depend on the machine. Each node makes
+//! Kensler's tree rotations as soon as its subtree is built ([`rotate_locally`]), which
+//! lowers the SAH cost where the greedy splits left room; then the nodes are laid out
+//! depth first again, child a's subtree right after its parent, child a being the one
+//! that holds more triangle area ([`ContentAreas`]), which any-hit walks visit first; it
+//! need not be the left one.
 //!
 //! With [`super::BvhBuilder::Split`] the references are not whole triangles but the
 //! pieces that early split clipping (`split`) cut the wasteful ones into; the build is
@@ -402,10 +402,11 @@ where
     });
 
     // Rotations and larger_first moved subtrees around: child a's subtree right after its
-    // parent again.
+    // parent again, and child a now the one holding more triangle area.
     // A binary tree of n leaves has n - 1 interior nodes (a root leaf still needs node 0).
     let interior = tally.leaves.max(2) - 1;
-    let (nodes, interior_area, deepest) = depth_first_layout(&nodes, interior);
+    let content = ContentAreas::new(&nodes, &tri_verts);
+    let (nodes, interior_area, deepest) = depth_first_layout(&nodes, interior, &content);
     let build_stats = stats(
         count,
         refs,
@@ -599,14 +600,80 @@ fn rotate_node(tree: &mut Region, i: usize, depth: u32, max_depth: u32) -> Optio
     Some(y.index as usize)
 }
 
+/// The triangle area below each node: how likely a segment through the node is to be
+/// occluded there. Any-hit walks visit child a first; making it the child that holds more
+/// triangle area (rather than the larger box, attempt 41) made the frame's shadow rays 3%
+/// faster and the accelerated frame's direct stage 11% (docs/PERFORMANCE.md attempt 80):
+/// a big box around a few slivers seldom stops a segment.
+struct ContentAreas<'a> {
+    /// By node index of the tree being laid out (0 where no walk from the root reaches).
+    below: Vec<f32>,
+    tri_verts: &'a [[f32; 4]],
+}
+
+impl<'a> ContentAreas<'a> {
+    /// One walk from the root, each node after its children (rotations left the nodes in
+    /// no index order).
+    fn new(nodes: &[BvhNode], tri_verts: &'a [[f32; 4]]) -> ContentAreas<'a> {
+        let mut areas = ContentAreas {
+            below: vec![0.0; nodes.len()],
+            tri_verts,
+        };
+        // (node, its children done)
+        let mut stack = vec![(0u32, false)];
+        while let Some((i, done)) = stack.pop() {
+            let n = nodes[i as usize];
+            if done {
+                areas.below[i as usize] = areas.of(&n.a()) + areas.of(&n.b());
+                continue;
+            }
+            stack.push((i, true));
+            for c in [n.a(), n.b()] {
+                if is_node(&c) {
+                    stack.push((c.index, false));
+                }
+            }
+        }
+        areas
+    }
+
+    /// The triangle area below a child (0 for the empty child of a root leaf; a triangle
+    /// with a non-finite vertex counts 0). A triangle cut by early split clipping counts
+    /// in full in each leaf that holds one of its pieces.
+    fn of(&self, c: &BvhChild) -> f32 {
+        if is_node(c) {
+            return self.below[c.index as usize];
+        }
+        if c.min.x > c.max.x {
+            return 0.0;
+        }
+        (c.index..c.index + c.count)
+            .map(|slot| {
+                let v = |k: usize| Vec3A::from_slice(&self.tri_verts[3 * slot as usize + k][..3]);
+                let a = 0.5 * (v(1) - v(0)).cross(v(2) - v(0)).length();
+                if a.is_finite() {
+                    a
+                } else {
+                    0.0
+                }
+            })
+            .sum()
+    }
+}
+
 /// The tree renumbered depth first, child a's subtree right after its parent (any-hit
-/// walks visit child a first), then child b's; with the sum of the interior nodes' half
-/// areas below the root and the deepest leaf's depth (the root has depth 0), for the
+/// walks visit child a first), then child b's, child a being the one with more triangle
+/// area below it (`content`; ties keep the order); with the sum of the interior nodes'
+/// half areas below the root and the deepest leaf's depth (the root has depth 0), for the
 /// SAH cost (`interior`: the tree's interior node count, for the output's capacity).
 /// One walk that writes each node at its new index and patches its parent's
 /// reference to it: on the conference room, 3.9-4.5 ms of the 2-core machine, against
 /// 9.3-10.7 ms for the three passes it replaced (list the order, renumber, sum).
-fn depth_first_layout(nodes: &[BvhNode], interior: usize) -> (Vec<BvhNode>, f64, u32) {
+fn depth_first_layout(
+    nodes: &[BvhNode],
+    interior: usize,
+    content: &ContentAreas,
+) -> (Vec<BvhNode>, f64, u32) {
     let mut out: Vec<BvhNode> = Vec::with_capacity(interior);
     let (mut interior_area, mut deepest) = (0.0f64, 0u32);
     // (node, its parent's new index and side (0: a, 1: b), its depth); the root has no parent.
@@ -621,7 +688,10 @@ fn depth_first_layout(nodes: &[BvhNode], interior: usize) -> (Vec<BvhNode>, f64,
                 p.b_index = k;
             }
         }
-        let n = nodes[i as usize];
+        let mut n = nodes[i as usize];
+        if content.of(&n.b()) > content.of(&n.a()) {
+            n = BvhNode::new(n.b(), n.a());
+        }
         out.push(n);
         // Areas in child order, node by node in the new order (the order the stats of
         // earlier builds summed in); b pushed first so that a's subtree comes next.
@@ -641,11 +711,11 @@ fn depth_first_layout(nodes: &[BvhNode], interior: usize) -> (Vec<BvhNode>, f64,
     (out, interior_area, deepest)
 }
 
-/// The node of two children, the one of larger surface area first: any-hit walks visit
-/// children in the node's order (the same for every ray, which keeps a warp's walks in
-/// step), and the larger box is the one a ray more likely hits (the SAH's own estimate),
-/// so an occluder tends to be found sooner. Frame shadow rays ran 9% faster, random
-/// segments 15% (docs/PERFORMANCE.md, attempt 41). Ties keep the given order.
+/// The node of two children, the one of larger surface area first. This was the order of
+/// the any-hit walks (attempt 41: 9-15% faster than the split's order) until the layout
+/// put the child holding more triangle area first ([`ContentAreas`], attempt 80); it
+/// stays the order in which the rotations compare children while the tree is built, so
+/// that they make the trees they were measured with.
 fn larger_first(a: BvhChild, b: BvhChild) -> BvhNode {
     if b.half_area() > a.half_area() {
         BvhNode::new(b, a)
