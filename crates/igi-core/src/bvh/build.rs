@@ -18,9 +18,9 @@
 //! whatever the thread count: the result does not depend on the machine. Each node makes
 //! Kensler's tree rotations as soon as its subtree is built ([`rotate_locally`]), which
 //! lowers the SAH cost where the greedy splits left room; then the nodes are laid out
-//! depth first again, child a's subtree right after its parent, child a being the one
-//! that holds more triangle area ([`ContentAreas`]), which any-hit walks visit first; it
-//! need not be the left one.
+//! depth first again (each node's two subtrees right after it, one after the other), and
+//! child a, which any-hit walks visit first, becomes the one that holds more triangle
+//! area ([`more_area_first`]); it need not be the left one.
 //!
 //! With [`super::BvhBuilder::Split`] the references are not whole triangles but the
 //! pieces that early split clipping (`split`) cut the wasteful ones into; the build is
@@ -401,12 +401,12 @@ where
         }
     });
 
-    // Rotations and larger_first moved subtrees around: child a's subtree right after its
-    // parent again, and child a now the one holding more triangle area.
+    // Rotations and larger_first moved subtrees around: each node's subtrees right after it
+    // again; then child a the one holding more triangle area.
     // A binary tree of n leaves has n - 1 interior nodes (a root leaf still needs node 0).
     let interior = tally.leaves.max(2) - 1;
-    let content = ContentAreas::new(&nodes, &tri_verts);
-    let (nodes, interior_area, deepest) = depth_first_layout(&nodes, interior, &content);
+    let (mut nodes, interior_area, deepest) = depth_first_layout(&nodes, interior);
+    more_area_first(&mut nodes, &tri_verts);
     let build_stats = stats(
         count,
         refs,
@@ -600,80 +600,58 @@ fn rotate_node(tree: &mut Region, i: usize, depth: u32, max_depth: u32) -> Optio
     Some(y.index as usize)
 }
 
-/// The triangle area below each node: how likely a segment through the node is to be
-/// occluded there. Any-hit walks visit child a first; making it the child that holds more
-/// triangle area (rather than the larger box, attempt 41) made the frame's shadow rays 3%
-/// faster and the accelerated frame's direct stage 11% (docs/PERFORMANCE.md attempt 80):
-/// a big box around a few slivers seldom stops a segment.
-struct ContentAreas<'a> {
-    /// By node index of the tree being laid out (0 where no walk from the root reaches).
-    below: Vec<f32>,
-    tri_verts: &'a [[f32; 4]],
-}
-
-impl<'a> ContentAreas<'a> {
-    /// One walk from the root, each node after its children (rotations left the nodes in
-    /// no index order).
-    fn new(nodes: &[BvhNode], tri_verts: &'a [[f32; 4]]) -> ContentAreas<'a> {
-        let mut areas = ContentAreas {
-            below: vec![0.0; nodes.len()],
-            tri_verts,
+/// Makes child a of every node the one holding more triangle area (ties keep the order),
+/// in a tree laid out depth first (children after their parents, which one pass from the
+/// last node to the first needs). The triangle area below a child is how likely a segment
+/// through it is to be occluded there; any-hit walks visit child a first, and making it
+/// the child of more triangle area rather than the larger box (attempt 41) made the
+/// frame's shadow rays 3% faster and the accelerated frame's direct stage 11%
+/// (docs/PERFORMANCE.md attempt 80): a big box around a few slivers seldom stops a
+/// segment. A triangle with a non-finite vertex counts 0; one cut by early split clipping
+/// counts in full in each leaf that holds one of its pieces. Where the children are
+/// swapped, child b's subtree is the one right after the node: laying the tree out again
+/// so that child a's came first measured the same on the H200 (attempt 80) and cost the
+/// build 4-8 ms.
+fn more_area_first(nodes: &mut [BvhNode], tri_verts: &[[f32; 4]]) {
+    let mut slot_area = vec![0.0f32; tri_verts.len() / 3];
+    par_chunks(&mut slot_area, 1, |base, chunk| {
+        for (k, out) in chunk.iter_mut().enumerate() {
+            let v = |j: usize| Vec3A::from_slice(&tri_verts[3 * (base + k) + j][..3]);
+            let a = 0.5 * (v(1) - v(0)).cross(v(2) - v(0)).length();
+            *out = if a.is_finite() { a } else { 0.0 };
+        }
+    });
+    let mut below = vec![0.0f32; nodes.len()];
+    for i in (0..nodes.len()).rev() {
+        let n = nodes[i];
+        let area = |c: &BvhChild| -> f32 {
+            if is_node(c) {
+                debug_assert!(c.index as usize > i, "not laid out depth first");
+                below[c.index as usize]
+            } else if c.min.x > c.max.x {
+                0.0 // the empty child of a root leaf
+            } else {
+                slot_area[c.index as usize..(c.index + c.count) as usize]
+                    .iter()
+                    .sum()
+            }
         };
-        // (node, its children done)
-        let mut stack = vec![(0u32, false)];
-        while let Some((i, done)) = stack.pop() {
-            let n = nodes[i as usize];
-            if done {
-                areas.below[i as usize] = areas.of(&n.a()) + areas.of(&n.b());
-                continue;
-            }
-            stack.push((i, true));
-            for c in [n.a(), n.b()] {
-                if is_node(&c) {
-                    stack.push((c.index, false));
-                }
-            }
+        let (area_a, area_b) = (area(&n.a()), area(&n.b()));
+        below[i] = area_a + area_b;
+        if area_b > area_a {
+            nodes[i] = BvhNode::new(n.b(), n.a());
         }
-        areas
-    }
-
-    /// The triangle area below a child (0 for the empty child of a root leaf; a triangle
-    /// with a non-finite vertex counts 0). A triangle cut by early split clipping counts
-    /// in full in each leaf that holds one of its pieces.
-    fn of(&self, c: &BvhChild) -> f32 {
-        if is_node(c) {
-            return self.below[c.index as usize];
-        }
-        if c.min.x > c.max.x {
-            return 0.0;
-        }
-        (c.index..c.index + c.count)
-            .map(|slot| {
-                let v = |k: usize| Vec3A::from_slice(&self.tri_verts[3 * slot as usize + k][..3]);
-                let a = 0.5 * (v(1) - v(0)).cross(v(2) - v(0)).length();
-                if a.is_finite() {
-                    a
-                } else {
-                    0.0
-                }
-            })
-            .sum()
     }
 }
 
-/// The tree renumbered depth first, child a's subtree right after its parent (any-hit
-/// walks visit child a first), then child b's, child a being the one with more triangle
-/// area below it (`content`; ties keep the order); with the sum of the interior nodes'
-/// half areas below the root and the deepest leaf's depth (the root has depth 0), for the
+/// The tree renumbered depth first, child a's subtree right after its parent, then child
+/// b's (before [`more_area_first`] picks child a); with the sum of the interior nodes' half
+/// areas below the root and the deepest leaf's depth (the root has depth 0), for the
 /// SAH cost (`interior`: the tree's interior node count, for the output's capacity).
 /// One walk that writes each node at its new index and patches its parent's
 /// reference to it: on the conference room, 3.9-4.5 ms of the 2-core machine, against
 /// 9.3-10.7 ms for the three passes it replaced (list the order, renumber, sum).
-fn depth_first_layout(
-    nodes: &[BvhNode],
-    interior: usize,
-    content: &ContentAreas,
-) -> (Vec<BvhNode>, f64, u32) {
+fn depth_first_layout(nodes: &[BvhNode], interior: usize) -> (Vec<BvhNode>, f64, u32) {
     let mut out: Vec<BvhNode> = Vec::with_capacity(interior);
     let (mut interior_area, mut deepest) = (0.0f64, 0u32);
     // (node, its parent's new index and side (0: a, 1: b), its depth); the root has no parent.
@@ -688,10 +666,7 @@ fn depth_first_layout(
                 p.b_index = k;
             }
         }
-        let mut n = nodes[i as usize];
-        if content.of(&n.b()) > content.of(&n.a()) {
-            n = BvhNode::new(n.b(), n.a());
-        }
+        let n = nodes[i as usize];
         out.push(n);
         // Areas in child order, node by node in the new order (the order the stats of
         // earlier builds summed in); b pushed first so that a's subtree comes next.
@@ -713,7 +688,7 @@ fn depth_first_layout(
 
 /// The node of two children, the one of larger surface area first. This was the order of
 /// the any-hit walks (attempt 41: 9-15% faster than the split's order) until the layout
-/// put the child holding more triangle area first ([`ContentAreas`], attempt 80); it
+/// put the child holding more triangle area first ([`more_area_first`], attempt 80); it
 /// stays the order in which the rotations compare children while the tree is built, so
 /// that they make the trees they were measured with.
 fn larger_first(a: BvhChild, b: BvhChild) -> BvhNode {

@@ -123,19 +123,22 @@ fn check_structure_of(bvh: &Bvh, tris: &[[Vec3; 3]], builder: BvhBuilder) {
     }
     assert!(leaf_slots.iter().all(|&s| s), "a slot in no leaf");
     assert!(node_seen.iter().all(|&s| s), "an unreachable node");
-    // Laid out depth first, child a's subtree right after its parent, then child b's:
-    // the walk in that order meets the nodes in index order.
+    // Laid out depth first: each node's two subtrees right after it, one after the other
+    // (child a's first, or child b's where more_area_first swapped them): the walk that
+    // takes the child of lower index first meets the nodes in index order.
     let mut order = vec![0u32];
     let mut next = 0u32;
     while let Some(node) = order.pop() {
         assert_eq!(node, next, "node {node} out of depth-first order");
         next += 1;
         let nd = bvh.nodes[node as usize];
-        for c in [nd.b(), nd.a()] {
-            if !c.is_leaf() && c.min.x <= c.max.x {
-                order.push(c.index);
-            }
-        }
+        let mut kids: Vec<u32> = [nd.a(), nd.b()]
+            .iter()
+            .filter(|c| !c.is_leaf() && c.min.x <= c.max.x)
+            .map(|c| c.index)
+            .collect();
+        kids.sort_unstable_by(|x, y| y.cmp(x));
+        order.extend(kids);
     }
     assert!(bvh.build_stats.max_depth <= MAX_DEPTH);
     // The statistics gathered while building are those of the finished tree.
