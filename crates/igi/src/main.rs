@@ -110,10 +110,8 @@ struct RaysArgs {
     height: Option<u32>,
     #[arg(long, default_value_t = 0)]
     seed: u32,
-    /// BVH builder: split (early split clipping of long thin triangles: a faster walk)
-    /// or binned (whole triangles: a faster build).
-    #[arg(long, value_enum, default_value = "split")]
-    bvh: BvhArg,
+    #[command(flatten)]
+    bvh: BvhChoice,
     /// Adapter: an index or part of a name from `igi info`.
     #[arg(long)]
     adapter: Option<String>,
@@ -155,16 +153,23 @@ struct BenchArgs {
     height: Option<u32>,
     #[arg(long, default_value_t = 0)]
     seed: u32,
-    /// BVH builder: split (early split clipping of long thin triangles: a faster walk)
-    /// or binned (whole triangles: a faster build).
-    #[arg(long, value_enum, default_value = "split")]
-    bvh: BvhArg,
+    #[command(flatten)]
+    bvh: BvhChoice,
     /// Adapter: an index or part of a name from `igi info`.
     #[arg(long)]
     adapter: Option<String>,
     /// No progress bar.
     #[arg(long)]
     quiet: bool,
+}
+
+/// The `--bvh` option of every command that builds a BVH.
+#[derive(Args)]
+struct BvhChoice {
+    /// BVH builder: split (early split clipping of long thin triangles: a faster walk)
+    /// or binned (whole triangles: a faster build).
+    #[arg(long = "bvh", value_enum, default_value = "split")]
+    builder: BvhArg,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -245,10 +250,8 @@ struct FrameArgs {
     /// Seed of the VPL set (a window of the Halton sequence).
     #[arg(long, default_value_t = 0)]
     seed: u32,
-    /// BVH builder: split (early split clipping of long thin triangles: a faster walk)
-    /// or binned (whole triangles: a faster build).
-    #[arg(long, value_enum, default_value = "split")]
-    bvh: BvhArg,
+    #[command(flatten)]
+    bvh: BvhChoice,
     /// Adapter to use: an index or part of a name from `igi info` (default: the best).
     #[arg(long)]
     adapter: Option<String>,
@@ -540,7 +543,7 @@ fn view(args: &ViewArgs) -> Result<()> {
         max_accumulate: args.max_accumulate.max(args.frame.accel.accumulate),
         render_scale: args.scale,
         show_vpls: args.vpl_dots,
-        bvh: args.frame.bvh.into(),
+        bvh: args.frame.bvh.builder.into(),
         window: args.window,
         scene,
     })
@@ -606,7 +609,7 @@ fn render(args: &RenderArgs) -> Result<()> {
     settings.exposure = args.exposure;
     settings.output = output_buffer(args.buffer);
     let t = Instant::now();
-    let builder = args.frame.bvh.into();
+    let builder = args.frame.bvh.builder.into();
     let bvh = Bvh::build_with(&scene.triangles, builder);
     let bvh_ms = t.elapsed().as_secs_f64() * 1e3;
     eprintln!(
@@ -687,7 +690,7 @@ fn bench(args: &BenchArgs) -> Result<()> {
         width: args.width,
         height: args.height,
         seed: args.seed,
-        bvh: args.bvh.into(),
+        bvh: args.bvh.builder.into(),
         adapter: args.adapter.clone(),
         quiet: args.quiet,
         command: std::env::args().collect::<Vec<_>>().join(" "),
@@ -717,7 +720,7 @@ fn bench_rays(args: &RaysArgs) -> Result<()> {
     }
     let scene = igi::bench::run::load(&args.scene)?;
     let t = Instant::now();
-    let builder = args.bvh.into();
+    let builder = args.bvh.builder.into();
     let bvh = Bvh::build_with(&scene.triangles, builder);
     let bvh_ms = t.elapsed().as_secs_f64() * 1e3;
     let ctx = GpuContext::new(&AdapterChoice::from_option(args.adapter.as_deref()))?;
