@@ -164,7 +164,7 @@ pub enum BvhBuilder {
     /// Ernst and Greiner 2007): the few long thin triangles whose boxes waste the most
     /// area are cut into pieces with tighter boxes. On the conference room 17% more
     /// references and about 1.3 times the build time of `Binned`, and every ray query
-    /// and frame faster on the H200 (docs/PERFORMANCE.md, attempts 77 and 79). Every
+    /// and frame faster on the H200 (docs/PERFORMANCE.md, attempts 77, 79 and 80). Every
     /// exact query answers as with `Binned` (closest-hit ties between triangles at one
     /// distance aside); imperfect visibility finds less false occlusion. The commands'
     /// default.
@@ -191,8 +191,8 @@ pub struct BuildStats {
     /// Wall time of [`Bvh::build`], in milliseconds.
     pub build_ms: f64,
     pub triangles: usize,
-    /// BVH slots: the triangles, plus the repeats of a triangle that spatial splits put
-    /// in more than one leaf ([`BvhBuilder::Split`]).
+    /// BVH slots: the triangles, plus the repeats of a triangle that early split clipping
+    /// put in more than one leaf ([`BvhBuilder::Split`]).
     pub references: usize,
     /// Interior nodes (entries of [`Bvh::nodes`]).
     pub nodes: usize,
