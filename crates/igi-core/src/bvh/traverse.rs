@@ -277,8 +277,16 @@ fn leaf_closest(bvh: &Bvh, first: u32, count: u32, r: &TraceRay, hit: &mut Hit) 
 }
 
 #[inline]
-fn leaf_any(bvh: &Bvh, first: u32, count: u32, r: &TraceRay, tmax: f32) -> bool {
+fn leaf_any(
+    bvh: &Bvh,
+    first: u32,
+    count: u32,
+    r: &TraceRay,
+    tmax: f32,
+    counter: &mut impl WalkCounter,
+) -> bool {
     (first..first + count).any(|slot| {
+        counter.triangle();
         let (v0, v1, v2) = slot_vertices(bvh, slot);
         intersect_triangle(r, v0, v1, v2, tmax).is_some()
     })
@@ -360,6 +368,45 @@ pub(crate) fn trace_closest(bvh: &Bvh, origin: Vec3, dir: Vec3, tmax: f32) -> Op
 /// attempt 31; the builder makes a the child holding more triangle area, attempt 80),
 /// returning at the first triangle hit with 0 < t < tmax.
 pub(crate) fn trace_any(bvh: &Bvh, origin: Vec3, dir: Vec3, tmax: f32) -> bool {
+    walk_any(bvh, origin, dir, tmax, &mut ())
+}
+
+/// What an any-hit walk did (tests and measurements count steps with it; `()` counts
+/// nothing and compiles away).
+pub(crate) trait WalkCounter {
+    fn node(&mut self);
+    fn triangle(&mut self);
+}
+
+impl WalkCounter for () {
+    #[inline(always)]
+    fn node(&mut self) {}
+    #[inline(always)]
+    fn triangle(&mut self) {}
+}
+
+/// Nodes visited and triangles tested.
+#[cfg(test)]
+impl WalkCounter for (u32, u32) {
+    fn node(&mut self) {
+        self.0 += 1;
+    }
+    fn triangle(&mut self) {
+        self.1 += 1;
+    }
+}
+
+/// [`trace_any`] counting its steps: (answer, nodes visited, triangles tested).
+#[cfg(test)]
+pub(crate) fn trace_any_counted(bvh: &Bvh, origin: Vec3, dir: Vec3, tmax: f32) -> (bool, u32, u32) {
+    let mut steps = (0u32, 0u32);
+    let hit = walk_any(bvh, origin, dir, tmax, &mut steps);
+    (hit, steps.0, steps.1)
+}
+
+/// The walk of [`trace_any`], telling `counter` of each node and triangle test.
+#[inline]
+fn walk_any(bvh: &Bvh, origin: Vec3, dir: Vec3, tmax: f32, counter: &mut impl WalkCounter) -> bool {
     let Some(r) = TraceRay::new(origin, dir) else {
         return false;
     };
@@ -367,11 +414,12 @@ pub(crate) fn trace_any(bvh: &Bvh, origin: Vec3, dir: Vec3, tmax: f32) -> bool {
     let mut sp = 0usize;
     let mut node = 0u32;
     loop {
+        counter.node();
         let n = &bvh.nodes[node as usize];
         let mut next = NO_HIT;
         if box_hit(n.a_min, n.a_max, &r, tmax) {
             if n.a_count > 0 {
-                if leaf_any(bvh, n.a_index, n.a_count, &r, tmax) {
+                if leaf_any(bvh, n.a_index, n.a_count, &r, tmax, counter) {
                     return true;
                 }
             } else {
@@ -380,7 +428,7 @@ pub(crate) fn trace_any(bvh: &Bvh, origin: Vec3, dir: Vec3, tmax: f32) -> bool {
         }
         if box_hit(n.b_min, n.b_max, &r, tmax) {
             if n.b_count > 0 {
-                if leaf_any(bvh, n.b_index, n.b_count, &r, tmax) {
+                if leaf_any(bvh, n.b_index, n.b_count, &r, tmax, counter) {
                     return true;
                 }
             } else if next == NO_HIT {
@@ -498,50 +546,4 @@ pub fn shadow_segment(x: Vec3, nx: Vec3, y: Vec3, ny: Vec3, floor: f32) -> (Vec3
     let o = offset_ray_origin(x, nx, floor);
     let e = offset_ray_origin(y, ny, floor);
     (o, e - o)
-}
-
-/// [`trace_any`] counting its steps: (answer, nodes visited, triangles tested).
-#[cfg(test)]
-pub(crate) fn trace_any_counted(bvh: &Bvh, origin: Vec3, dir: Vec3, tmax: f32) -> (bool, u32, u32) {
-    let Some(r) = TraceRay::new(origin, dir) else {
-        return (false, 0, 0);
-    };
-    let (mut nodes, mut tris) = (0u32, 0u32);
-    let mut stack = [0u32; MAX_DEPTH as usize];
-    let mut sp = 0usize;
-    let mut node = 0u32;
-    loop {
-        nodes += 1;
-        let n = &bvh.nodes[node as usize];
-        let mut next = NO_HIT;
-        for (lo, hi, index, count, second) in [
-            (n.a_min, n.a_max, n.a_index, n.a_count, false),
-            (n.b_min, n.b_max, n.b_index, n.b_count, true),
-        ] {
-            if box_hit(lo, hi, &r, tmax) {
-                if count > 0 {
-                    for slot in index..index + count {
-                        tris += 1;
-                        if leaf_any(bvh, slot, 1, &r, tmax) {
-                            return (true, nodes, tris);
-                        }
-                    }
-                } else if next == NO_HIT {
-                    next = index;
-                } else {
-                    debug_assert!(second);
-                    stack[sp] = index;
-                    sp += 1;
-                }
-            }
-        }
-        if next == NO_HIT {
-            if sp == 0 {
-                return (false, nodes, tris);
-            }
-            sp -= 1;
-            next = stack[sp];
-        }
-        node = next;
-    }
 }

@@ -2,7 +2,7 @@
 //! with E at full resolution or upsampled on the way (joint bilateral upsampling, paper
 //! section 4.2). See `shaders/compose.wgsl`.
 
-use super::{bind, image_groups, pass_layout, pipeline};
+use super::{bind, image_groups, pass_layout, pipeline, Step};
 use crate::scene_buffers::{READ, UNIFORM, WRITE};
 
 pub struct ComposePass {
@@ -36,12 +36,7 @@ impl ComposePass {
 
     /// The dispatch over a `width` x `height` image; with `upsample`, the E buffer bound
     /// is at the indirect term's resolution and is upsampled pixel by pixel.
-    pub fn steps(
-        &self,
-        width: u32,
-        height: u32,
-        upsample: bool,
-    ) -> [(&wgpu::ComputePipeline, [u32; 3]); 1] {
+    pub fn steps(&self, width: u32, height: u32, upsample: bool) -> [Step<'_>; 1] {
         let pipeline = if upsample {
             &self.upsampled
         } else {

@@ -1,7 +1,7 @@
 //! Direct + specular at full resolution (paper section 4, second stage), writing the
 //! G-buffer of the primary hits. See `shaders/direct.wgsl`.
 
-use super::{bind, pass_layout, GatherPipelines};
+use super::{bind, pass_layout, GatherPipelines, Step};
 use crate::scene_buffers::{READ, UNIFORM, WRITE};
 
 /// Pixels per workgroup of the direct pass (`@workgroup_size` of direct.wgsl): one warp,
@@ -75,7 +75,7 @@ impl DirectPass {
         height: u32,
         imperfect_visibility: bool,
         most_groups: u32,
-    ) -> [(&wgpu::ComputePipeline, [u32; 3]); 1] {
+    ) -> [Step<'_>; 1] {
         let most = (width as u64 * height as u64).div_ceil(CHAIN_GROUP as u64);
         let groups = most.clamp(1, most_groups.max(1) as u64) as u32;
         [(self.chains.get(imperfect_visibility), [groups, 1, 1])]
@@ -111,12 +111,7 @@ impl DirectPass {
     }
 
     /// The first walk, over every pixel.
-    pub fn steps(
-        &self,
-        width: u32,
-        height: u32,
-        imperfect_visibility: bool,
-    ) -> [(&wgpu::ComputePipeline, [u32; 3]); 1] {
+    pub fn steps(&self, width: u32, height: u32, imperfect_visibility: bool) -> [Step<'_>; 1] {
         [(
             self.pipelines.get(imperfect_visibility),
             [

@@ -3,7 +3,7 @@
 //! work). Joint bilateral upsampling on its own is done by the compose pass as it writes
 //! each pixel. See `shaders/filter.wgsl`.
 
-use super::{bind, image_groups, pass_layout, pipeline};
+use super::{bind, image_groups, pass_layout, pipeline, Step};
 use crate::scene_buffers::{READ, UNIFORM, WRITE};
 
 pub struct FilterPass {
@@ -46,12 +46,7 @@ impl FilterPass {
 
     /// The dispatch of `filter`: the discontinuity buffer runs at the indirect term's
     /// resolution, the fused filter at full resolution.
-    pub fn steps(
-        &self,
-        filter: Filter,
-        full: (u32, u32),
-        low: (u32, u32),
-    ) -> [(&wgpu::ComputePipeline, [u32; 3]); 1] {
+    pub fn steps(&self, filter: Filter, full: (u32, u32), low: (u32, u32)) -> [Step<'_>; 1] {
         match filter {
             Filter::Discontinuity => [(&self.discontinuity, image_groups(low.0, low.1))],
             Filter::Fused => [(&self.fused, image_groups(full.0, full.1))],

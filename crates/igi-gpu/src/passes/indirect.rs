@@ -5,7 +5,7 @@
 //! the paper gathers every VPL there and leaves that cost as future work).
 //! See `shaders/indirect.wgsl`.
 
-use super::{bind, pass_layout, GatherPipelines, LanePipelines};
+use super::{bind, pass_layout, GatherPipelines, LanePipelines, Step};
 use crate::scene_buffers::{READ, UNIFORM, WRITE};
 
 /// Threads of a workgroup of the gather over the list of mirrored pixels (indirect.wgsl
@@ -90,7 +90,7 @@ impl IndirectPass {
         interleave: (u32, u32),
         imperfect_visibility: bool,
         most_groups: u32,
-    ) -> [(&wgpu::ComputePipeline, [u32; 3]); 1] {
+    ) -> [Step<'_>; 1] {
         let (n, m) = interleave;
         let subsets = n * m;
         let bucket = width.div_ceil(n) as u64 * height.div_ceil(m) as u64;
@@ -113,7 +113,7 @@ impl IndirectPass {
         imperfect_visibility: bool,
         lanes: u32,
         interleave: (u32, u32),
-    ) -> [(&wgpu::ComputePipeline, [u32; 3]); 1] {
+    ) -> [Step<'_>; 1] {
         [self
             .pipelines
             .step(width, height, imperfect_visibility, lanes, interleave)]

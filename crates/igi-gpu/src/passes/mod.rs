@@ -232,7 +232,7 @@ impl LanePipelines {
         imperfect_visibility: bool,
         lanes: u32,
         interleave: (u32, u32),
-    ) -> (&wgpu::ComputePipeline, [u32; 3]) {
+    ) -> Step<'_> {
         let index = LANE_CHOICES.iter().position(|&l| l == lanes).unwrap_or(0);
         let pipeline = self.by_lanes[index].get(imperfect_visibility);
         if lanes > 1 {
@@ -395,11 +395,14 @@ pub struct GatherRanges<'a> {
     pub count: u32,
 }
 
+/// A dispatch: a pipeline and its workgroup counts.
+pub type Step<'a> = (&'a wgpu::ComputePipeline, [u32; 3]);
+
 /// What one compute pass runs for one pass of the frame: each step's pipeline over its
 /// workgroups, with the scene's and the pass's bind groups; with `ranges`, every step runs
 /// once per VPL range (bind group 2).
 pub(crate) struct Dispatches<'a> {
-    pub steps: &'a [(&'a wgpu::ComputePipeline, [u32; 3])],
+    pub steps: &'a [Step<'a>],
     pub scene: &'a wgpu::BindGroup,
     pub pass: &'a wgpu::BindGroup,
     pub ranges: Option<&'a GatherRanges<'a>>,
@@ -558,7 +561,7 @@ impl<'a> Recorder<'a> {
         &mut self,
         stage: u32,
         label: &str,
-        steps: &[(&wgpu::ComputePipeline, [u32; 3])],
+        steps: &[Step],
         scene: &wgpu::BindGroup,
         pass: &wgpu::BindGroup,
         ranges: Option<&GatherRanges>,

@@ -1,7 +1,7 @@
 //! VPL shooting (paper section 4, first stage): light paths from the point lights leave
 //! VPLs at diffuse hits, compacted into a dense list. See `shaders/vpl.wgsl`.
 
-use super::{bind, pass_layout, pipeline};
+use super::{bind, pass_layout, pipeline, Step};
 use crate::scene_buffers::{READ, UNIFORM, WRITE};
 
 /// Threads per workgroup of the shooting kernel (`SHOOT_GROUP` in the WGSL).
@@ -10,9 +10,6 @@ pub const SHOOT_GROUP: u32 = 64;
 pub const COMPACT_GROUP: u32 = 256;
 /// Largest number of workgroups in one dimension of a dispatch.
 const MAX_GROUPS: u32 = 65535;
-
-/// A dispatch: a pipeline and its workgroup counts.
-pub type Step<'a> = (&'a wgpu::ComputePipeline, [u32; 3]);
 
 pub struct VplPass {
     pub layout: wgpu::BindGroupLayout,
