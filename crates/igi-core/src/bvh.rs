@@ -105,16 +105,25 @@ pub struct BvhChild {
 }
 
 impl BvhChild {
-    /// The child that no ray hits: an inverted infinite box, a leaf of one triangle.
+    /// The child that no ray hits: a point box at +inf (every slab distance of an axis is
+    /// +inf, so the box is entered at +inf, or -inf, so it is left at -inf), a leaf of one
+    /// triangle. Not an inverted box: the slab test takes the nearer and farther planes by
+    /// min and max, which would make an inverted box span every axis.
     pub const EMPTY: BvhChild = BvhChild {
         min: Vec3::INFINITY,
-        max: Vec3::NEG_INFINITY,
+        max: Vec3::INFINITY,
         index: 0,
         count: 1,
     };
 
     pub fn is_leaf(&self) -> bool {
         self.count > 0
+    }
+
+    /// Whether this is [`BvhChild::EMPTY`] (the second child of a root leaf, or both
+    /// children of the root of no triangles).
+    pub fn is_empty(&self) -> bool {
+        *self == BvhChild::EMPTY
     }
 
     /// Half the surface area of the child's box (0 for an empty or inverted one).
@@ -274,8 +283,12 @@ impl Bvh {
     /// Box of the whole scene (min, max); inverted-infinite for no triangles.
     pub fn bounds(&self) -> (Vec3, Vec3) {
         let n = &self.nodes[0];
-        let (a, b) = (n.a(), n.b());
-        (a.min.min(b.min), a.max.max(b.max))
+        [n.a(), n.b()]
+            .into_iter()
+            .filter(|c| !c.is_empty())
+            .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), c| {
+                (lo.min(c.min), hi.max(c.max))
+            })
     }
 
     /// Closest hit with 0 < t < tmax, or None. `t` is in units of `dir` (which need not

@@ -628,7 +628,7 @@ fn more_area_first(nodes: &mut [BvhNode], tri_verts: &[[f32; 4]]) {
             if is_node(c) {
                 debug_assert!(c.index as usize > i, "not laid out depth first");
                 below[c.index as usize]
-            } else if c.min.x > c.max.x {
+            } else if c.is_empty() {
                 0.0 // the empty child of a root leaf
             } else {
                 slot_area[c.index as usize..(c.index + c.count) as usize]
@@ -1125,7 +1125,7 @@ pub(super) fn stats_by_walk(bvh: &Bvh) -> BuildStats {
     for (i, n) in bvh.nodes.iter().enumerate() {
         for c in [n.a(), n.b()] {
             if c.is_leaf() {
-                if c.min.x > c.max.x {
+                if c.is_empty() {
                     continue; // the empty child
                 }
                 t.leaf(c.count as usize, area(&c));

@@ -89,8 +89,7 @@ fn check_structure_of(bvh: &Bvh, tris: &[[Vec3; 3]], builder: BvhBuilder) {
             "node {node}: child a holds less triangle area"
         );
         for c in [nd.a(), nd.b()] {
-            if c.min.x > c.max.x {
-                assert_eq!((c.index, c.count), (0, 1), "empty child");
+            if c.is_empty() {
                 continue;
             }
             if let Some((lo, hi)) = parent {
@@ -157,7 +156,7 @@ fn check_structure_of(bvh: &Bvh, tris: &[[Vec3; 3]], builder: BvhBuilder) {
 /// The triangle area below a child, summed as the builder sums it (slot by slot in a
 /// leaf, a's and b's for a node), so that ties compare equal.
 fn content_area(bvh: &Bvh, c: &BvhChild) -> f32 {
-    if c.min.x > c.max.x {
+    if c.is_empty() {
         return 0.0;
     }
     if c.count == 0 {
@@ -243,6 +242,25 @@ fn empty_bvh_misses_everything() {
     // Rays along the axes, also through the origin.
     for d in [Vec3::X, Vec3::NEG_Y, Vec3::Z] {
         assert!(bvh.trace_closest(Vec3::ZERO, d, 1e30).is_none());
+    }
+    // The empty children are point boxes at +inf: rays of every octant and axis, the
+    // ones heading their way included, miss them with the GPU's largest tmax (3.4e38)
+    // and with an infinite one (a hit would test slot 0, which does not exist).
+    for i in 0..27 {
+        let d = Vec3::new(
+            (i % 3) as f32 - 1.0,
+            (i / 3 % 3) as f32 - 1.0,
+            (i / 9) as f32 - 1.0,
+        );
+        if d == Vec3::ZERO {
+            continue;
+        }
+        for tmax in [1.0, 3.4e38, f32::MAX, f32::INFINITY] {
+            for o in [Vec3::ZERO, Vec3::splat(-1e7), Vec3::splat(1e7)] {
+                assert!(bvh.trace_closest(o, d, tmax).is_none(), "{o} {d} {tmax}");
+                assert!(!bvh.trace_any(o, d, tmax), "{o} {d} {tmax}");
+            }
+        }
     }
 }
 

@@ -33,7 +33,7 @@ pub const NO_HIT: u32 = 0xffff_ffff;
 /// large value did, 6-10% of every walk (docs/PERFORMANCE.md attempt 35). Boxes only get
 /// wider along parallel axes, so the answers stay those of the exact test. No NaN or
 /// infinity arises from finite data (coordinates up to ~1e7); the only infinities are
-/// those of the empty child's box (+inf, -inf), whose distances are +-inf and only make
+/// those of the empty child's point box at +inf, whose distances are +-inf and only make
 /// it miss.
 ///
 /// A component below 1e-30 that is not exactly 0 moves the ray by less than 1e-30 t along
@@ -81,8 +81,6 @@ pub struct Hit {
 pub(crate) struct TraceRay {
     origin: Vec3,
     inv_dir: Vec3,
-    /// Per axis: whether inv_dir < 0 (then the slab is entered at the box maximum).
-    neg: [bool; 3],
     /// Woop et al.: kz is the axis of the largest |dir| component, (kx, ky) the other two
     /// in an order that keeps the triangles' winding.
     kx: usize,
@@ -139,7 +137,6 @@ impl TraceRay {
             origin_hi: origin - slack,
             origin,
             inv_dir,
-            neg: [inv_dir.x < 0.0, inv_dir.y < 0.0, inv_dir.z < 0.0],
             kx,
             ky,
             kz,
@@ -149,26 +146,21 @@ impl TraceRay {
 }
 
 /// Slab test: the (entry, exit) distances of a box clipped to [0, tmax]; the box is hit
-/// when entry <= exit. The entry plane of each axis is chosen by the sign of the
-/// direction (not by min/max of both planes), so an inverted empty box (min = +inf,
-/// max = -inf) enters at +inf and leaves at -inf: never hit. Parallel axes need no case
-/// of their own: their planes are measured from the moved origins (see [`DIR_EPS`]).
+/// when entry <= exit. Each axis enters at the nearer of its two planes and leaves at the
+/// farther (min and max of the two distances; with a choice by the direction's sign
+/// instead, the NVIDIA driver spilled 12 bytes a thread of the GPU's gather to shared
+/// memory and the gathers ran 3.5% slower, docs/PERFORMANCE.md attempt 81). So the child
+/// no ray may hit is a point box at +inf ([`super::BvhChild::EMPTY`]), not an inverted
+/// one, and the walks' tmax is finite ([`finite_tmax`]). Parallel axes need no case of
+/// their own: their planes are measured from the moved origins (see [`DIR_EPS`]).
 #[inline]
 fn box_span(min: [f32; 3], max: [f32; 3], r: &TraceRay, tmax: f32) -> (f32, f32) {
     let t0 = (Vec3::from(min) - r.origin_lo) * r.inv_dir;
     let t1 = (Vec3::from(max) - r.origin_hi) * r.inv_dir;
-    let pick = |k: usize| {
-        if r.neg[k] {
-            (t1[k], t0[k])
-        } else {
-            (t0[k], t1[k])
-        }
-    };
-    let (nx, fx) = pick(0);
-    let (ny, fy) = pick(1);
-    let (nz, fz) = pick(2);
-    let near = nx.max(ny).max(nz.max(0.0));
-    let far = (fx.min(fy).min(fz) * BOX_TFAR_SCALE).min(tmax);
+    let tn = t0.min(t1);
+    let tf = t0.max(t1);
+    let near = tn.x.max(tn.y).max(tn.z.max(0.0));
+    let far = (tf.x.min(tf.y).min(tf.z) * BOX_TFAR_SCALE).min(tmax);
     (near, far)
 }
 
@@ -304,6 +296,15 @@ fn children(node: &super::BvhNode, r: &TraceRay, tmax: f32) -> [(f32, u32, u32);
     ]
 }
 
+/// The walks' tmax: an infinite one becomes f32::MAX. The empty child's point box at
+/// +inf ([`super::BvhChild::EMPTY`]) is entered at +inf by the rays heading its way, and
+/// only a far end of +inf could reach it. The GPU walks never see an infinity (WGSL has
+/// none, and their callers pass at most 3.4e38); only a hit at t = f32::MAX is lost.
+#[inline]
+fn finite_tmax(tmax: f32) -> f32 {
+    tmax.min(f32::MAX)
+}
+
 /// [`children`], nearer first (ties: child a first; a missed child goes second).
 #[inline]
 fn ordered(node: &super::BvhNode, r: &TraceRay, tmax: f32) -> [(f32, u32, u32); 2] {
@@ -321,7 +322,7 @@ fn ordered(node: &super::BvhNode, r: &TraceRay, tmax: f32) -> [(f32, u32, u32); 
 pub(crate) fn trace_closest(bvh: &Bvh, origin: Vec3, dir: Vec3, tmax: f32) -> Option<Hit> {
     let r = TraceRay::new(origin, dir)?;
     let mut hit = Hit {
-        t: tmax,
+        t: finite_tmax(tmax),
         tri: NO_HIT,
         u: 0.0,
         v: 0.0,
@@ -410,6 +411,7 @@ fn walk_any(bvh: &Bvh, origin: Vec3, dir: Vec3, tmax: f32, counter: &mut impl Wa
     let Some(r) = TraceRay::new(origin, dir) else {
         return false;
     };
+    let tmax = finite_tmax(tmax);
     let mut stack = [0u32; MAX_DEPTH as usize];
     let mut sp = 0usize;
     let mut node = 0u32;

@@ -54,19 +54,12 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
 // coherence, not correctness: attempt 30), and group.z is that place in the tile. The
 // lanes' sums are added in lane order.
 override COHERENT_LANES: u32 = 8u;
-// One sum per thread of the workgroup (main_coherent's 32 COHERENT_LANES, main_list's
-// LIST_GROUP).
-var<workgroup> coherent_sums: array<vec4<f32>, max(32u * COHERENT_LANES, LIST_GROUP)>;
-
-// The sum of pixel p's `lanes` lane sums in lane order (lane k of the workgroup's
-// `pixels` pixels stored its sum at k pixels + p), after a workgroup barrier.
-fn lanes_total(p: u32, pixels: u32, lanes: u32) -> vec3<f32> {
-    var total = vec3<f32>(0.0);
-    for (var k = 0u; k < lanes; k += 1u) {
-        total += coherent_sums[k * pixels + p].xyz;
-    }
-    return total;
-}
+// One sum per thread of the workgroup: main_coherent's here, main_list's below. Each
+// entry point has its own array, sized by its own pipeline constant: one array sized for
+// both took 4 KiB of shared memory from every main_coherent workgroup of 128 threads,
+// which needs 2 (shared memory is taken from the L1 cache the walks live in,
+// docs/PERFORMANCE.md attempts 45 and 81).
+var<workgroup> coherent_sums: array<vec4<f32>, 32u * COHERENT_LANES>;
 
 @compute @workgroup_size(32u * COHERENT_LANES)
 fn main_coherent(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) l: u32) {
@@ -84,7 +77,12 @@ fn main_coherent(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocat
     coherent_sums[l] = vec4<f32>(sum, 0.0);
     workgroupBarrier();
     if (inside && lane == 0u) {
-        store_irradiance(x, y, lanes_total(p, 32u, COHERENT_LANES));
+        // The lanes' sums in lane order.
+        var total = vec3<f32>(0.0);
+        for (var k = 0u; k < COHERENT_LANES; k += 1u) {
+            total += coherent_sums[k * 32u + p].xyz;
+        }
+        store_irradiance(x, y, total);
     }
 }
 
@@ -101,6 +99,7 @@ fn main_coherent(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocat
 // warp always holds one lane of 32 pixels; it takes LIST_GROUP / VPL_LANES listed pixels.
 // Set by frame.rs (`passes::indirect::list_group`).
 override LIST_GROUP: u32 = 256u;
+var<workgroup> list_sums: array<vec4<f32>, LIST_GROUP>;
 
 // The gather over the listed pixels of bucket group.z, VPL_LANES threads per pixel, a
 // warp holding one lane of 32 pixels (as main_coherent): they trace to the same VPL at
@@ -125,10 +124,15 @@ fn main_list(@builtin(workgroup_id) group: vec3<u32>, @builtin(num_workgroups) g
             pixel = mirror_list[MAX_SUBSETS + bucket * mirror_bucket_size() + slot];
             sum = pixel_sum(pixel % params.low_width, pixel / params.low_width, lane, VPL_LANES);
         }
-        coherent_sums[l] = vec4<f32>(sum, 0.0);
+        list_sums[l] = vec4<f32>(sum, 0.0);
         workgroupBarrier();
         if (inside && lane == 0u) {
-            store_irradiance(pixel % params.low_width, pixel / params.low_width, lanes_total(p, per_group, VPL_LANES));
+            // The lanes' sums in lane order.
+            var total = vec3<f32>(0.0);
+            for (var k = 0u; k < VPL_LANES; k += 1u) {
+                total += list_sums[k * per_group + p].xyz;
+            }
+            store_irradiance(pixel % params.low_width, pixel / params.low_width, total);
         }
         // The next pixels' sums overwrite these.
         workgroupBarrier();

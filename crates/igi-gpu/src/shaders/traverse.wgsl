@@ -59,7 +59,7 @@ struct TraceRay {
     kx: u32,
     ky: u32,
     kz: u32,
-    // inv_dir < 0: the slab of that axis is entered at the box maximum.
+    // inv_dir < 0: the slab of that axis is entered at the box maximum (box_crossed).
     neg: vec3<bool>,
     // |dir| < DIR_EPS: the ray is parallel to that axis' slab (box_crossed).
     parallel: vec3<bool>,
@@ -101,15 +101,18 @@ fn make_ray(origin: vec3<f32>, dir: vec3<f32>) -> TraceRay {
 }
 
 // Slab test: (entry, exit) distances of a box clipped to [0, tmax]; the box is hit when
-// entry <= exit. Entry planes are chosen by the direction's sign, so an inverted empty
-// box (+inf, -inf) is never hit. Parallel axes need no case of their own: their planes
-// are measured from the moved origins (the select this replaced cost 6-10% of every
-// walk, PERFORMANCE.md attempt 35).
+// entry <= exit. Each axis enters at the nearer plane and leaves at the farther (min and
+// max; with selects by the direction's sign instead, the NVIDIA driver spilled 12 bytes a
+// thread of the gather to shared memory and the gathers ran 3.5% slower,
+// docs/PERFORMANCE.md attempt 81). So the child no ray may hit is a point box at +inf,
+// not an inverted one (igi_core's BvhChild::EMPTY); tmax is always finite here (WGSL has
+// no infinity). Parallel axes need no case of their own: their planes are measured from
+// the moved origins (the select this replaced cost 6-10% of every walk, attempt 35).
 fn box_span(bmin: vec3<f32>, bmax: vec3<f32>, r: TraceRay, tmax: f32) -> vec2<f32> {
     let t0 = (bmin - r.origin_lo) * r.inv_dir;
     let t1 = (bmax - r.origin_hi) * r.inv_dir;
-    let tn = select(t0, t1, r.neg);
-    let tf = select(t1, t0, r.neg);
+    let tn = min(t0, t1);
+    let tf = max(t0, t1);
     let near = max(max(tn.x, tn.y), max(tn.z, 0.0));
     let far = min(min(min(tf.x, tf.y), tf.z) * BOX_TFAR_SCALE, tmax);
     return vec2<f32>(near, far);
