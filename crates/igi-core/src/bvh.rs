@@ -75,11 +75,12 @@ pub const SAH_INTERSECT_COST: f32 = 1.0;
 /// | 48..60 | `b_max`   | child b: box maximum                                         |
 /// | 60..64 | `b_count` | child b: 0 = interior node, n > 0 = leaf                     |
 ///
-/// Child a is the one holding more triangle area (any-hit walks visit it first, see
-/// `build`). Leaf triangles are BVH slots `index .. index + count` of [`Bvh::tri_verts`].
-/// An empty child (the second child of a root that is a single leaf, both children of the
-/// BVH of no triangles) has min = +inf, max = -inf, count 1, index 0: its box is never
-/// hit.
+/// Child a is the likelier occluder per unit of work: the larger ratio of triangle area
+/// below it to its subtree's SAH cost (any-hit walks visit it first, see `build`). Leaf
+/// triangles are BVH slots `index .. index + count` of [`Bvh::tri_verts`]. An empty child
+/// (the second child of a root that is a single leaf, both children of the BVH of no
+/// triangles) has min = max = +inf, count 1, index 0: [`BvhChild::EMPTY`], a box no ray
+/// with a finite tmax hits.
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable, Debug, PartialEq)]
 pub struct BvhNode {

@@ -19,8 +19,8 @@
 //! Kensler's tree rotations as soon as its subtree is built ([`rotate_locally`]), which
 //! lowers the SAH cost where the greedy splits left room; then the nodes are laid out
 //! depth first again (each node's two subtrees right after it, one after the other), and
-//! child a, which any-hit walks visit first, becomes the one that holds more triangle
-//! area ([`more_area_first`]); it need not be the left one.
+//! child a, which any-hit walks visit first, becomes the one likelier to stop them per
+//! unit of work ([`occluder_first`]); it need not be the left one.
 //!
 //! With [`super::BvhBuilder::Split`] the references are not whole triangles but the
 //! pieces that early split clipping (`split`) cut the wasteful ones into; the build is
@@ -402,11 +402,11 @@ where
     });
 
     // Rotations and larger_first moved subtrees around: each node's subtrees right after it
-    // again; then child a the one holding more triangle area.
+    // again; then child a the likelier occluder (occluder_first).
     // A binary tree of n leaves has n - 1 interior nodes (a root leaf still needs node 0).
     let interior = tally.leaves.max(2) - 1;
     let (mut nodes, interior_area, deepest) = depth_first_layout(&nodes, interior);
-    more_area_first(&mut nodes, &tri_verts);
+    occluder_first(&mut nodes, &tri_verts);
     let build_stats = stats(
         count,
         refs,
@@ -600,19 +600,25 @@ fn rotate_node(tree: &mut Region, i: usize, depth: u32, max_depth: u32) -> Optio
     Some(y.index as usize)
 }
 
-/// Makes child a of every node the one holding more triangle area (ties keep the order),
-/// in a tree laid out depth first (children after their parents, which one pass from the
-/// last node to the first needs). The triangle area below a child is how likely a segment
-/// through it is to be occluded there; any-hit walks visit child a first, and making it
-/// the child of more triangle area rather than the larger box (attempt 41) made the
-/// frame's shadow rays 3% faster and the accelerated frame's direct stage 11%
-/// (docs/PERFORMANCE.md attempt 80): a big box around a few slivers seldom stops a
-/// segment. A triangle with a non-finite vertex counts 0; one cut by early split clipping
-/// counts in full in each leaf that holds one of its pieces. Where the children are
-/// swapped, child b's subtree is the one right after the node: laying the tree out again
-/// so that child a's came first measured the same on the H200 (attempt 80) and cost the
-/// build 4-8 ms.
-fn more_area_first(nodes: &mut [BvhNode], tri_verts: &[[f32; 4]]) {
+/// Makes child a of every node the child likelier to stop an any-hit walk per unit of
+/// work: the one with the larger ratio of the triangle area below it to the SAH cost of
+/// its subtree (ties keep the order), in a tree laid out depth first (children after
+/// their parents, which one pass from the last node to the first needs). Any-hit walks
+/// visit child a first. When a segment enters both children, visiting A first costs
+/// C_A + (1 - p_A) C_B, where p is the chance of an occluder in the child and C the
+/// expected work there; A goes first when p_A / C_A > p_B / C_B. Given that the segment
+/// enters a child's box, p grows with the triangle area inside over the box's area
+/// (Cauchy: a random line meets a flat triangle of area a in a box of half area h with
+/// probability a / h), and C is the subtree's SAH cost over the box's area, so the box
+/// areas cancel: the key is triangle area / SAH cost. On the H200 this took canonical
+/// frames from 10.69 to 10.53 ms and the frame's shadow rays from 5.43 to 5.49 G rays/s
+/// against child a holding more triangle area (attempt 80), and cost the random segments
+/// 0.6% (docs/PERFORMANCE.md attempt 84). A triangle with a non-finite vertex counts 0;
+/// one cut by early split clipping counts in full in each leaf that holds one of its
+/// pieces. Where the children are swapped, child b's subtree is the one right after the
+/// node: laying the tree out again so that child a's came first measured the same on the
+/// H200 (attempt 80) and cost the build 4-8 ms.
+fn occluder_first(nodes: &mut [BvhNode], tri_verts: &[[f32; 4]]) {
     let mut slot_area = vec![0.0f32; tri_verts.len() / 3];
     par_chunks(&mut slot_area, 1, |base, chunk| {
         for (k, out) in chunk.iter_mut().enumerate() {
@@ -621,31 +627,37 @@ fn more_area_first(nodes: &mut [BvhNode], tri_verts: &[[f32; 4]]) {
             *out = if a.is_finite() { a } else { 0.0 };
         }
     });
-    let mut below = vec![0.0f32; nodes.len()];
+    // Per node: the triangle area and the SAH cost (not divided by any area) below it.
+    let mut below = vec![(0.0f32, 0.0f32); nodes.len()];
     for i in (0..nodes.len()).rev() {
         let n = nodes[i];
-        let area = |c: &BvhChild| -> f32 {
+        let content = |c: &BvhChild| -> (f32, f32) {
             if is_node(c) {
                 debug_assert!(c.index as usize > i, "not laid out depth first");
                 below[c.index as usize]
             } else if c.is_empty() {
-                0.0 // the empty child of a root leaf
+                (0.0, 0.0) // the empty child of a root leaf
             } else {
-                slot_area[c.index as usize..(c.index + c.count) as usize]
-                    .iter()
-                    .sum()
+                let slots = c.index as usize..(c.index + c.count) as usize;
+                let cost = SAH_INTERSECT_COST * c.count as f32 * c.half_area();
+                (slot_area[slots].iter().sum(), cost)
             }
         };
-        let (area_a, area_b) = (area(&n.a()), area(&n.b()));
-        below[i] = area_a + area_b;
-        if area_b > area_a {
+        let ((area_a, cost_a), (area_b, cost_b)) = (content(&n.a()), content(&n.b()));
+        let visit = SAH_TRAVERSAL_COST * union(&n.a(), &n.b()).half_area();
+        // area_b / cost_b > area_a / cost_a without dividing (an empty child: 0 > 0).
+        // The sums are taken in the final order of the children.
+        below[i] = if area_b * cost_a > area_a * cost_b {
             nodes[i] = BvhNode::new(n.b(), n.a());
-        }
+            (area_b + area_a, visit + cost_b + cost_a)
+        } else {
+            (area_a + area_b, visit + cost_a + cost_b)
+        };
     }
 }
 
 /// The tree renumbered depth first, child a's subtree right after its parent, then child
-/// b's (before [`more_area_first`] picks child a); with the sum of the interior nodes' half
+/// b's (before [`occluder_first`] picks child a); with the sum of the interior nodes' half
 /// areas below the root and the deepest leaf's depth (the root has depth 0), for the
 /// SAH cost (`interior`: the tree's interior node count, for the output's capacity).
 /// One walk that writes each node at its new index and patches its parent's
@@ -688,7 +700,7 @@ fn depth_first_layout(nodes: &[BvhNode], interior: usize) -> (Vec<BvhNode>, f64,
 
 /// The node of two children, the one of larger surface area first. This was the order of
 /// the any-hit walks (attempt 41: 9-15% faster than the split's order) until the layout
-/// put the child holding more triangle area first ([`more_area_first`], attempt 80); it
+/// put the likelier occluder first ([`occluder_first`], attempts 80 and 84); it
 /// stays the order in which the rotations compare children while the tree is built, so
 /// that they make the trees they were measured with.
 fn larger_first(a: BvhChild, b: BvhChild) -> BvhNode {

@@ -82,11 +82,12 @@ fn check_structure_of(bvh: &Bvh, tris: &[[Vec3; 3]], builder: BvhBuilder) {
         assert!(!node_seen[node as usize], "node {node} reached twice");
         node_seen[node as usize] = true;
         let nd = bvh.nodes[node as usize];
-        // Any-hit walks visit child a first: the one holding more triangle area (attempt
-        // 80).
+        // Any-hit walks visit child a first: the one of larger triangle area per unit of
+        // SAH cost (attempt 84).
+        let ((area_a, cost_a), (area_b, cost_b)) = (content(bvh, &nd.a()), content(bvh, &nd.b()));
         assert!(
-            content_area(bvh, &nd.a()) >= content_area(bvh, &nd.b()),
-            "node {node}: child a holds less triangle area"
+            area_a * cost_b >= area_b * cost_a,
+            "node {node}: child a holds less triangle area per unit of SAH cost"
         );
         for c in [nd.a(), nd.b()] {
             if c.is_empty() {
@@ -123,7 +124,7 @@ fn check_structure_of(bvh: &Bvh, tris: &[[Vec3; 3]], builder: BvhBuilder) {
     assert!(leaf_slots.iter().all(|&s| s), "a slot in no leaf");
     assert!(node_seen.iter().all(|&s| s), "an unreachable node");
     // Laid out depth first: each node's two subtrees right after it, one after the other
-    // (child a's first, or child b's where more_area_first swapped them): the walk that
+    // (child a's first, or child b's where occluder_first swapped them): the walk that
     // takes the child of lower index first meets the nodes in index order.
     let mut order = vec![0u32];
     let mut next = 0u32;
@@ -153,17 +154,22 @@ fn check_structure_of(bvh: &Bvh, tris: &[[Vec3; 3]], builder: BvhBuilder) {
     assert_eq!(&walked, built);
 }
 
-/// The triangle area below a child, summed as the builder sums it (slot by slot in a
-/// leaf, a's and b's for a node), so that ties compare equal.
-fn content_area(bvh: &Bvh, c: &BvhChild) -> f32 {
+/// The triangle area and the SAH cost (not divided by any area) below a child, summed as
+/// the builder sums them (slot by slot in a leaf, a's and b's for a node), so that ties
+/// compare equal.
+fn content(bvh: &Bvh, c: &BvhChild) -> (f32, f32) {
     if c.is_empty() {
-        return 0.0;
+        return (0.0, 0.0);
     }
     if c.count == 0 {
         let n = bvh.nodes[c.index as usize];
-        return content_area(bvh, &n.a()) + content_area(bvh, &n.b());
+        let ((area_a, cost_a), (area_b, cost_b)) = (content(bvh, &n.a()), content(bvh, &n.b()));
+        let (lo, hi) = (n.a().min.min(n.b().min), n.a().max.max(n.b().max));
+        let e = hi - lo;
+        let visit = SAH_TRAVERSAL_COST * (e.x * e.y + e.y * e.z + e.z * e.x);
+        return (area_a + area_b, visit + cost_a + cost_b);
     }
-    (c.index..c.index + c.count)
+    let area = (c.index..c.index + c.count)
         .map(|slot| {
             let [v0, v1, v2] = bvh.triangle(slot).map(glam::Vec3A::from);
             let a = 0.5 * (v1 - v0).cross(v2 - v0).length();
@@ -173,7 +179,8 @@ fn content_area(bvh: &Bvh, c: &BvhChild) -> f32 {
                 0.0
             }
         })
-        .sum()
+        .sum();
+    (area, SAH_INTERSECT_COST * c.count as f32 * c.half_area())
 }
 
 /// The BVH's closest hit must be the brute force's (same triangle, or another at the

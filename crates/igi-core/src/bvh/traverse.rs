@@ -366,7 +366,8 @@ pub(crate) fn trace_closest(bvh: &Bvh, origin: Vec3, dir: Vec3, tmax: f32) -> Op
 
 /// Any hit: the walk of [`trace_closest`] without pruning and in fixed child order (a,
 /// then b: the nearer-first order made the GPU's frames 4-7% slower, docs/PERFORMANCE.md
-/// attempt 31; the builder makes a the child holding more triangle area, attempt 80),
+/// attempt 31; the builder makes a the likelier occluder per unit of work, attempts 80
+/// and 84),
 /// returning at the first triangle hit with 0 < t < tmax.
 pub(crate) fn trace_any(bvh: &Bvh, origin: Vec3, dir: Vec3, tmax: f32) -> bool {
     walk_any(bvh, origin, dir, tmax, &mut ())
