@@ -76,7 +76,8 @@ pub const SAH_INTERSECT_COST: f32 = 1.0;
 /// | 60..64 | `b_count` | child b: 0 = interior node, n > 0 = leaf                     |
 ///
 /// Child a is the likelier occluder per unit of work: the larger ratio of triangle area
-/// below it to its subtree's SAH cost (any-hit walks visit it first, see `build`). Leaf
+/// below it to the SAH cost of the interior nodes below it (any-hit walks visit it first,
+/// see `build`). Leaf
 /// triangles are BVH slots `index .. index + count` of [`Bvh::tri_verts`]. An empty child
 /// (the second child of a root that is a single leaf, both children of the BVH of no
 /// triangles) has min = max = +inf, count 1, index 0: [`BvhChild::EMPTY`], a box no ray

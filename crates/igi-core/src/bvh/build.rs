@@ -601,23 +601,28 @@ fn rotate_node(tree: &mut Region, i: usize, depth: u32, max_depth: u32) -> Optio
 }
 
 /// Makes child a of every node the child likelier to stop an any-hit walk per unit of
-/// work: the one with the larger ratio of the triangle area below it to the SAH cost of
-/// its subtree (ties keep the order), in a tree laid out depth first (children after
-/// their parents, which one pass from the last node to the first needs). Any-hit walks
-/// visit child a first. When a segment enters both children, visiting A first costs
-/// C_A + (1 - p_A) C_B, where p is the chance of an occluder in the child and C the
-/// expected work there; A goes first when p_A / C_A > p_B / C_B. Given that the segment
-/// enters a child's box, p grows with the triangle area inside over the box's area
-/// (Cauchy: a random line meets a flat triangle of area a in a box of half area h with
-/// probability a / h), and C is the subtree's SAH cost over the box's area, so the box
-/// areas cancel: the key is triangle area / SAH cost. On the H200 this took canonical
-/// frames from 10.69 to 10.53 ms and the frame's shadow rays from 5.43 to 5.49 G rays/s
-/// against child a holding more triangle area (attempt 80), and cost the random segments
-/// 0.6% (docs/PERFORMANCE.md attempt 84). A triangle with a non-finite vertex counts 0;
-/// one cut by early split clipping counts in full in each leaf that holds one of its
-/// pieces. Where the children are swapped, child b's subtree is the one right after the
-/// node: laying the tree out again so that child a's came first measured the same on the
-/// H200 (attempt 80) and cost the build 4-8 ms.
+/// work: the one with the larger ratio of the triangle area below it to the interior
+/// nodes' SAH cost below it (ties keep the order), in a tree laid out depth first
+/// (children after their parents, which one pass from the last node to the first needs).
+/// Any-hit walks visit child a first. When a segment enters both children, visiting A
+/// first costs C_A + (1 - p_A) C_B, where p is the chance of an occluder in the child and
+/// C the expected work there; A goes first when p_A / C_A > p_B / C_B. Given that the
+/// segment enters a child's box, p grows with the triangle area inside over the box's
+/// area (Cauchy: a random line meets a flat triangle of area a in a box of half area h
+/// with probability a / h), and C with the half areas of the interior nodes below over
+/// the box's (the node visits to expect), so the box areas cancel. Leaves cost 0: the
+/// walks test a leaf child's triangles as soon as its box is hit, whichever child it is,
+/// so the order only matters between two interior children (then the key decides) and
+/// between two leaves (then 0 against 0 keeps the larger box first, which measured best).
+/// Counting the leaves' triangle tests in C at the SAH's weight made the walks slower,
+/// and the less they weighed the faster they were (docs/PERFORMANCE.md attempt 84). On the
+/// H200 against child a holding more triangle area (attempt 80): canonical frames 10.69 ->
+/// 10.40 ms, the frame's shadow rays 5.43 -> 5.62 and the random segments 2.09 -> 2.12
+/// G rays/s. A triangle with a non-finite vertex counts 0; one cut by early split
+/// clipping counts in full in each leaf that holds one of its pieces. Where the children
+/// are swapped, child b's subtree is the one right after the node: laying the tree out
+/// again so that child a's came first measured the same on the H200 (attempt 80) and cost
+/// the build 4-8 ms.
 fn occluder_first(nodes: &mut [BvhNode], tri_verts: &[[f32; 4]]) {
     let mut slot_area = vec![0.0f32; tri_verts.len() / 3];
     par_chunks(&mut slot_area, 1, |base, chunk| {
@@ -627,7 +632,8 @@ fn occluder_first(nodes: &mut [BvhNode], tri_verts: &[[f32; 4]]) {
             *out = if a.is_finite() { a } else { 0.0 };
         }
     });
-    // Per node: the triangle area and the SAH cost (not divided by any area) below it.
+    // Per node: the triangle area and the interior nodes' SAH cost (not divided by any
+    // area) below it.
     let mut below = vec![(0.0f32, 0.0f32); nodes.len()];
     for i in (0..nodes.len()).rev() {
         let n = nodes[i];
@@ -639,13 +645,13 @@ fn occluder_first(nodes: &mut [BvhNode], tri_verts: &[[f32; 4]]) {
                 (0.0, 0.0) // the empty child of a root leaf
             } else {
                 let slots = c.index as usize..(c.index + c.count) as usize;
-                let cost = SAH_INTERSECT_COST * c.count as f32 * c.half_area();
-                (slot_area[slots].iter().sum(), cost)
+                (slot_area[slots].iter().sum(), 0.0)
             }
         };
         let ((area_a, cost_a), (area_b, cost_b)) = (content(&n.a()), content(&n.b()));
         let visit = SAH_TRAVERSAL_COST * union(&n.a(), &n.b()).half_area();
-        // area_b / cost_b > area_a / cost_a without dividing (an empty child: 0 > 0).
+        // area_b / cost_b > area_a / cost_a without dividing (two leaves, or a leaf and the
+        // empty child: 0 > 0).
         // The sums are taken in the final order of the children.
         below[i] = if area_b * cost_a > area_a * cost_b {
             nodes[i] = BvhNode::new(n.b(), n.a());

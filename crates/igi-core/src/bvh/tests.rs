@@ -83,7 +83,7 @@ fn check_structure_of(bvh: &Bvh, tris: &[[Vec3; 3]], builder: BvhBuilder) {
         node_seen[node as usize] = true;
         let nd = bvh.nodes[node as usize];
         // Any-hit walks visit child a first: the one of larger triangle area per unit of
-        // SAH cost (attempt 84).
+        // the interior nodes' SAH cost below it (attempt 84).
         let ((area_a, cost_a), (area_b, cost_b)) = (content(bvh, &nd.a()), content(bvh, &nd.b()));
         assert!(
             area_a * cost_b >= area_b * cost_a,
@@ -154,8 +154,8 @@ fn check_structure_of(bvh: &Bvh, tris: &[[Vec3; 3]], builder: BvhBuilder) {
     assert_eq!(&walked, built);
 }
 
-/// The triangle area and the SAH cost (not divided by any area) below a child, summed as
-/// the builder sums them (slot by slot in a leaf, a's and b's for a node), so that ties
+/// The triangle area and the interior nodes' SAH cost (not divided by any area) below a
+/// child, summed as the builder sums them (slot by slot in a leaf, a's and b's for a node), so that ties
 /// compare equal.
 fn content(bvh: &Bvh, c: &BvhChild) -> (f32, f32) {
     if c.is_empty() {
@@ -180,7 +180,7 @@ fn content(bvh: &Bvh, c: &BvhChild) -> (f32, f32) {
             }
         })
         .sum();
-    (area, SAH_INTERSECT_COST * c.count as f32 * c.half_area())
+    (area, 0.0)
 }
 
 /// The BVH's closest hit must be the brute force's (same triangle, or another at the

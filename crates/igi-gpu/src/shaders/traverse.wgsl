@@ -299,9 +299,9 @@ fn trace_closest(origin: vec3<f32>, dir: vec3<f32>, tmax: f32) -> Hit {
 // hits need, made frames 4-7% slower here (docs/PERFORMANCE.md attempt 31; probably
 // because a fixed order keeps the walks of a warp's rays, which end at one point, in
 // step). The builder makes child a the likelier occluder per unit of work: the larger
-// ratio of triangle area to SAH cost below it (attempt 84: canonical 1.5% faster than
-// the child of more triangle area, attempt 80, which was 3% faster than the larger box
-// first, attempt 41, which was 9-15% faster than the split's order).
+// ratio of triangle area to the interior nodes' SAH cost below it (attempt 84: canonical
+// 2.7% faster than the child of more triangle area, attempt 80, which was 3% faster than
+// the larger box first, attempt 41, which was 9-15% faster than the split's order).
 // With `boxes` (imperfect visibility), a triangle whose box the segment crosses counts
 // as a hit (see box_crossed).
 fn trace_shadow(origin: vec3<f32>, dir: vec3<f32>, tmax: f32, boxes: bool) -> bool {
