@@ -814,7 +814,22 @@ fn compare(image: &std::path::Path, reference: &std::path::Path) -> Result<()> {
     Ok(())
 }
 
+/// The Rust runtime ignores SIGPIPE, so that a write to a closed pipe (`igi info | head
+/// -0`, or a pager quit early) returns an error, which print! turns into a panic. Like
+/// other Unix tools, igi stops quietly there instead: the default action of SIGPIPE.
+/// Output files are unaffected (they are written under a temporary name and renamed,
+/// igi_core::image).
+#[cfg(unix)]
+fn quiet_on_closed_pipes() {
+    // SAFETY: called first in main, before any thread exists; SIG_DFL is a valid action.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
+}
+
 fn main() -> ExitCode {
+    #[cfg(unix)]
+    quiet_on_closed_pipes();
     env_logger::Builder::from_env(
         env_logger::Env::default()
             .default_filter_or("warn,wgpu_core=error,wgpu_hal=off,naga=error"),

@@ -496,3 +496,24 @@ fn out_of_memory_in_a_frame_is_one_clear_error() {
         .collect();
     assert!(left.is_empty(), "left behind: {left:?}");
 }
+
+#[test]
+fn closed_stdout_is_no_panic() {
+    // `igi info | head -0`: the reader is gone before igi writes. A Unix tool stops
+    // quietly there (SIGPIPE); Rust's print! would panic with "failed printing to stdout".
+    let mut child = common::igi_command()
+        .arg("info")
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("run igi");
+    drop(child.stdout.take());
+    let out = child.wait_with_output().expect("wait for igi");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!stderr.contains("panicked"), "panic: {stderr}");
+    assert_ne!(
+        out.status.code(),
+        Some(101),
+        "exit code of a panic; stderr: {stderr}"
+    );
+}
