@@ -112,12 +112,13 @@ pub const LANE_CHOICES: [u32; 4] = [1, 4, 8, 16];
 
 /// Lanes per pixel of the indirect pass at the mirrored hits (the mirror indirect stage,
 /// over the list of those pixels): few pixels see a mirror (18000 of 480000 in the
-/// conference room), so their VPL loops are split over 8 threads; one lane on a software
+/// conference room), so their VPL loops are split over 4 threads; one lane on a software
 /// adapter. 8 beat 32 and 1 on the H200 at 800 x 600 and 1920 x 1080, canonical and
-/// interleaved (docs/PERFORMANCE.md, attempts 17 and 26). 16 took the stage from 0.92 to
-/// 0.83 ms in canonical frames at 800 x 600, but made it 25-40% slower in interleaved ones
-/// and no faster at 1920 x 1080 (attempt 51). `IGI_MIRROR_LANES` (1, 2,
-/// 4, 8, 16 or 32) overrides it, for measurements.
+/// interleaved (docs/PERFORMANCE.md, attempts 17 and 26), and 16 was slower in
+/// interleaved frames (attempt 51). Since the gathers run side by side, 4 beat 8 by 1.2%
+/// in the accelerated frames at both sizes, with canonical the same; 2 and 16 did not
+/// (attempt 87). `IGI_MIRROR_LANES` (1, 2, 4, 8, 16 or 32) overrides it, for
+/// measurements.
 pub fn mirror_lanes(software: bool) -> u32 {
     if let Some(l) = std::env::var("IGI_MIRROR_LANES")
         .ok()
@@ -130,7 +131,7 @@ pub fn mirror_lanes(software: bool) -> u32 {
     if software {
         1
     } else {
-        8
+        4
     }
 }
 
