@@ -77,11 +77,10 @@ pub const SAH_INTERSECT_COST: f32 = 1.0;
 ///
 /// Child a is the likelier occluder per unit of work: the larger ratio of triangle area
 /// below it to the SAH cost of the interior nodes below it (any-hit walks visit it first,
-/// see `build`). Leaf
-/// triangles are BVH slots `index .. index + count` of [`Bvh::tri_verts`]. An empty child
-/// (the second child of a root that is a single leaf, both children of the BVH of no
-/// triangles) has min = max = +inf, count 1, index 0: [`BvhChild::EMPTY`], a box no ray
-/// with a finite tmax hits.
+/// see `build`). Leaf triangles are BVH slots `index .. index + count` of
+/// [`Bvh::tri_verts`]. An empty child (the second child of a root that is a single leaf,
+/// both children of the BVH of no triangles) has min = max = +inf, count 1, index 0:
+/// [`BvhChild::EMPTY`], a box no ray with a finite tmax hits.
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable, Debug, PartialEq)]
 pub struct BvhNode {

@@ -817,8 +817,8 @@ fn compare(image: &std::path::Path, reference: &std::path::Path) -> Result<()> {
 /// The Rust runtime ignores SIGPIPE, so that a write to a closed pipe (`igi info | head
 /// -0`, or a pager quit early) returns an error, which print! turns into a panic. Like
 /// other Unix tools, igi stops quietly there instead: the default action of SIGPIPE.
-/// Output files are unaffected (they are written under a temporary name and renamed,
-/// igi_core::image).
+/// Image files are written under a temporary name and renamed into place
+/// (igi_core::image), so such a stop leaves no half-written file under an output's name.
 #[cfg(unix)]
 fn quiet_on_closed_pipes() {
     // SAFETY: called first in main, before any thread exists; SIG_DFL is a valid action.

@@ -155,8 +155,8 @@ fn check_structure_of(bvh: &Bvh, tris: &[[Vec3; 3]], builder: BvhBuilder) {
 }
 
 /// The triangle area and the interior nodes' SAH cost (not divided by any area) below a
-/// child, summed as the builder sums them (slot by slot in a leaf, a's and b's for a node), so that ties
-/// compare equal.
+/// child, summed as the builder sums them (slot by slot in a leaf, a's and b's for a
+/// node), so that ties compare equal.
 fn content(bvh: &Bvh, c: &BvhChild) -> (f32, f32) {
     if c.is_empty() {
         return (0.0, 0.0);

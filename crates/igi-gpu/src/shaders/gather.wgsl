@@ -125,8 +125,8 @@ fn vpl_irradiance(p: vec3<f32>, ng: vec3<f32>, ns: vec3<f32>, first: u32, count:
 }
 
 // Threads that share one pixel's VPL loop in the gathers over a list of pixels (a
-// pipeline constant dividing 256: passes::mirror_lanes, 4 on GPUs, 1 on software ones). A pass with few pixels to gather at (the
-// pixels that see a mirror) cannot fill a big GPU with one thread each, so each pixel's
-// VPLs are split over lanes, and lane 0 adds the lanes' sums in lane order (the same
-// image every run).
+// pipeline constant dividing 256: passes::mirror_lanes, 4 on GPUs, 1 on software ones).
+// A pass with few pixels to gather at (the pixels that see a mirror) cannot fill a big
+// GPU with one thread each, so each pixel's VPLs are split over lanes, and lane 0 adds
+// the lanes' sums in lane order (the same image every run).
 override VPL_LANES: u32 = 8u;
