@@ -528,9 +528,10 @@ impl Region<'_> {
     }
 }
 
-/// Whether a child is an interior node (not a leaf, not the empty child of a root leaf).
+/// Whether a child is an interior node (not a leaf; the empty child of a root leaf is a
+/// leaf of one triangle, `BvhChild::EMPTY`).
 fn is_node(c: &BvhChild) -> bool {
-    c.count == 0 && c.min.x <= c.max.x
+    !c.is_leaf()
 }
 
 /// Kensler's tree rotations ("Tree Rotations for Improving Bounding Volume Hierarchies",

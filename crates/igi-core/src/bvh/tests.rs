@@ -164,9 +164,13 @@ fn content(bvh: &Bvh, c: &BvhChild) -> (f32, f32) {
     if c.count == 0 {
         let n = bvh.nodes[c.index as usize];
         let ((area_a, cost_a), (area_b, cost_b)) = (content(bvh, &n.a()), content(bvh, &n.b()));
-        let (lo, hi) = (n.a().min.min(n.b().min), n.a().max.max(n.b().max));
-        let e = hi - lo;
-        let visit = SAH_TRAVERSAL_COST * (e.x * e.y + e.y * e.z + e.z * e.x);
+        let union = BvhChild {
+            min: n.a().min.min(n.b().min),
+            max: n.a().max.max(n.b().max),
+            index: 0,
+            count: 0,
+        };
+        let visit = SAH_TRAVERSAL_COST * union.half_area();
         return (area_a + area_b, visit + cost_a + cost_b);
     }
     let area = (c.index..c.index + c.count)

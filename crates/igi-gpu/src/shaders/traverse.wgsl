@@ -59,8 +59,6 @@ struct TraceRay {
     kx: u32,
     ky: u32,
     kz: u32,
-    // inv_dir < 0: the slab of that axis is entered at the box maximum (box_crossed).
-    neg: vec3<bool>,
     // |dir| < DIR_EPS: the ray is parallel to that axis' slab (box_crossed).
     parallel: vec3<bool>,
     // The origins box_span measures entry (origin_lo) and exit (origin_hi) planes from:
@@ -97,7 +95,7 @@ fn make_ray(origin: vec3<f32>, dir: vec3<f32>) -> TraceRay {
     }
     let shear = vec3<f32>(dir[kx] / dir[kz], dir[ky] / dir[kz], 1.0 / dir[kz]);
     let slack = select(vec3<f32>(0.0), (abs(origin) + 1.0) * PARALLEL_SLACK, parallel);
-    return TraceRay(origin, inv_dir, shear, kx, ky, kz, inv_dir < vec3<f32>(0.0), parallel, origin + slack, origin - slack);
+    return TraceRay(origin, inv_dir, shear, kx, ky, kz, parallel, origin + slack, origin - slack);
 }
 
 // Slab test: (entry, exit) distances of a box clipped to [0, tmax]; the box is hit when
@@ -228,8 +226,9 @@ const BOX_MARGIN: f32 = 1e-4;
 fn box_crossed(bmin: vec3<f32>, bmax: vec3<f32>, r: TraceRay, tmax: f32) -> bool {
     let t0 = (bmin - r.origin) * r.inv_dir;
     let t1 = (bmax - r.origin) * r.inv_dir;
-    var tn = select(t0, t1, r.neg);
-    var tf = select(t1, t0, r.neg);
+    // Nearer and farther plane by min and max, as in box_span.
+    var tn = min(t0, t1);
+    var tf = max(t0, t1);
     // A parallel axis: inside the slab (any t) or never.
     let inside = r.origin >= bmin & r.origin <= bmax;
     tn = select(tn, select(vec3<f32>(FAR_BIG), vec3<f32>(-FAR_BIG), inside), r.parallel);
