@@ -45,8 +45,9 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let r = rays[i];
     var res: TestResult;
-    res.hit = trace_closest(r.origin, r.dir, r.tmax);
-    res.any_hit = select(0u, 1u, trace_any(r.origin, r.dir, r.tmax));
+    var stack: WalkStack;
+    res.hit = trace_closest(&stack, r.origin, r.dir, r.tmax);
+    res.any_hit = select(0u, 1u, trace_any(&stack, r.origin, r.dir, r.tmax));
     res.offset = offset_ray_origin(r.origin, r.normal, r.floor);
     results[i] = res;
 }

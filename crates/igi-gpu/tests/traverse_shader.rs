@@ -17,8 +17,9 @@ const KERNEL: &str = r#"
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let o = vec3<f32>(f32(gid.x), 0.5, -3.0);
-    let h = trace_closest(o, vec3<f32>(0.0, 0.0, 1.0), 1e30);
-    let a = trace_any(o, vec3<f32>(0.0, 1.0, 0.0), 1.0);
+    var stack: WalkStack;
+    let h = trace_closest(&stack, o, vec3<f32>(0.0, 0.0, 1.0), 1e30);
+    let a = trace_any(&stack, o, vec3<f32>(0.0, 1.0, 0.0), 1.0);
     let p = offset_ray_origin(o, vec3<f32>(0.0, 1.0, 0.0), 0.0);
     let s = shadow_segment(o, vec3<f32>(0.0, 1.0, 0.0), p, vec3<f32>(1.0, 0.0, 0.0), 0.25);
     out[gid.x] = vec4<f32>(h.t + f32(h.tri) + h.u + h.v, select(0.0, 1.0, a), p.x + s.origin.y, s.dir.z);

@@ -86,6 +86,7 @@ fn shade(x: u32, y: u32) {
         // seen in a mirror.
         radiance = direct_out[pixel].xyz;
     }
+    var stack: WalkStack;
     var traced = 0u;
     var recorded = false;
     // Whether the chain reaches a hit seen in a mirror seen in a mirror (first walk).
@@ -93,7 +94,7 @@ fn shade(x: u32, y: u32) {
     // Length of the chain so far: the mirrored hit's depth for the mirror filter.
     var travelled = 0.0;
     for (var depth = 0u; depth <= params.mirror_depth; depth += 1u) {
-        let hit = trace_closest(origin, dir, INFINITY);
+        let hit = trace_closest(&stack, origin, dir, INFINITY);
         traced += 1u;
         if (hit.tri == NO_HIT) {
             break;
@@ -109,7 +110,7 @@ fn shade(x: u32, y: u32) {
         if (max(s.diffuse.x, max(s.diffuse.y, s.diffuse.z)) > 0.0) {
             var e = vec3<f32>(0.0);
             if (first_walk) {
-                e = direct_irradiance(s.position, s.geometric_normal, s.shading_normal);
+                e = direct_irradiance(&stack, s.position, s.geometric_normal, s.shading_normal);
             }
             let weight = throughput * s.diffuse / PI;
             if (depth > 0u && !recorded) {
@@ -127,7 +128,7 @@ fn shade(x: u32, y: u32) {
                 if (first_walk) {
                     chained = true;
                 } else {
-                    e += vpl_irradiance(s.position, s.geometric_normal, s.shading_normal, gather_first(), gather_last(), 1u);
+                    e += vpl_irradiance(&stack, s.position, s.geometric_normal, s.shading_normal, gather_first(), gather_last(), 1u);
                 }
             }
             radiance += weight * e;

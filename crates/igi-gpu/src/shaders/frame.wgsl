@@ -140,7 +140,7 @@ fn count_rays(kind: u32, n: u32) {
 }
 
 // Irradiance from the point lights at p (shadow rays from the surface to each light).
-fn direct_irradiance(p: vec3<f32>, ng: vec3<f32>, ns: vec3<f32>) -> vec3<f32> {
+fn direct_irradiance(stack: ptr<function, WalkStack>, p: vec3<f32>, ng: vec3<f32>, ns: vec3<f32>) -> vec3<f32> {
     var e = vec3<f32>(0.0);
     let origin = offset_ray_origin(p, ng, params.ray_offset_floor);
     var traced = 0u;
@@ -153,7 +153,7 @@ fn direct_irradiance(p: vec3<f32>, ng: vec3<f32>, ns: vec3<f32>) -> vec3<f32> {
             continue;
         }
         traced += 1u;
-        if (trace_any(origin, light.position - origin, 1.0)) {
+        if (trace_any(stack, origin, light.position - origin, 1.0)) {
             continue;
         }
         e += light.intensity * cos_x / dist2;

@@ -35,15 +35,23 @@ fn gather_last() -> u32 {
 
 // Interleaved sampling (paper section 4.3): the VPL subset of pixel (x, y) of the image
 // being gathered (the indirect term's, or the mirrored hits'): its place in its n x m
-// tile, through a permutation drawn for the tile (seeded Fisher-Yates) when the pattern
-// is irregular.
+// tile, through a permutation drawn for the tile when the pattern is irregular.
 fn interleave_subset(x: u32, y: u32) -> u32 {
-    let n = params.interleave_n;
-    let m = params.interleave_m;
-    let local = (x % n) + n * (y % m);
+    let local = (x % params.interleave_n) + params.interleave_n * (y % params.interleave_m);
     if (params.pattern == 0u) {
         return local;
     }
+    return irregular_subset(x, y, local);
+}
+
+// The irregular pattern's subset at place `local` of pixel (x, y)'s tile: a seeded
+// Fisher-Yates permutation of the tile's places. A function of its own, so that its
+// permutation array (zeroed where it is declared, as every WGSL variable) costs only the
+// irregular pattern: zeroed in interleave_subset, it took 1.5-2% of iv+ds+il frames with
+// the regular one (docs/PERFORMANCE.md attempt 89).
+fn irregular_subset(x: u32, y: u32, local: u32) -> u32 {
+    let n = params.interleave_n;
+    let m = params.interleave_m;
     var perm: array<u32, 64>;
     let count = n * m;
     for (var i = 0u; i < count; i += 1u) {
@@ -78,7 +86,8 @@ fn subset_irradiance(p: vec3<f32>, ng: vec3<f32>, ns: vec3<f32>, x: u32, y: u32,
     // First VPL of the subset within the dispatch's range, then this lane's.
     let begin = gather_first();
     let first = begin + (subset + subsets - begin % subsets) % subsets + lane * subsets;
-    return vpl_irradiance(p, ng, ns, first, gather_last(), subsets * lanes);
+    var stack: WalkStack;
+    return vpl_irradiance(&stack, p, ng, ns, first, gather_last(), subsets * lanes);
 }
 
 // What a pixel holds after this dispatch: what earlier VPL ranges left (`previous`,
@@ -92,7 +101,7 @@ fn accumulated_irradiance(previous: vec4<f32>, sum: vec3<f32>) -> vec4<f32> {
     return vec4<f32>(e + f32(params.interleave_n * params.interleave_m) * sum, 1.0);
 }
 
-fn vpl_irradiance(p: vec3<f32>, ng: vec3<f32>, ns: vec3<f32>, first: u32, count: u32, stride: u32) -> vec3<f32> {
+fn vpl_irradiance(stack: ptr<function, WalkStack>, p: vec3<f32>, ng: vec3<f32>, ns: vec3<f32>, first: u32, count: u32, stride: u32) -> vec3<f32> {
     var e = vec3<f32>(0.0);
     var traced = 0u;
     for (var k = first; k < count; k += stride) {
@@ -115,7 +124,7 @@ fn vpl_irradiance(p: vec3<f32>, ng: vec3<f32>, ns: vec3<f32>, first: u32, count:
         // faster on the H200 (docs/PERFORMANCE.md attempt 81).
         let origin = offset_ray_origin(p, ng, params.ray_offset_floor);
         traced += 1u;
-        if (trace_shadow(origin, end - origin, 1.0, IMPERFECT_VISIBILITY)) {
+        if (trace_shadow(stack, origin, end - origin, 1.0, IMPERFECT_VISIBILITY)) {
             continue;
         }
         e += vpl.flux * vpl.albedo * (g / PI);

@@ -22,6 +22,14 @@ const NO_HIT: u32 = 0xffffffffu;
 // never holds more than MAX_DEPTH entries and cannot overflow.
 const STACK_SIZE: u32 = 60u;
 
+// The traversal stack. The walks take it by pointer from their caller, which declares
+// one per invocation, outside its loops over rays: WGSL zero-initialises a function's
+// variables where they are declared (naga writes the null initializer, and the driver
+// stores it), so a stack declared in trace_shadow cost every walk 240 bytes of stores:
+// 2.6% of a canonical frame on the H200 (docs/PERFORMANCE.md attempt 89). A walk never
+// reads an entry it did not push, so one stack serves any number of walks.
+alias WalkStack = array<u32, STACK_SIZE>;
+
 // Direction components below this count as zero for the slab test (parallel axes).
 const DIR_EPS: f32 = 1e-30;
 // Reciprocal of a parallel axis: finite, since WGSL makes inf and NaN indeterminate.
@@ -241,13 +249,12 @@ fn box_crossed(bmin: vec3<f32>, bmax: vec3<f32>, r: TraceRay, tmax: f32) -> bool
 // Closest hit with 0 < t < tmax; Hit.tri == NO_HIT (and t = tmax) on a miss. `dir` need
 // not be normalised: t is in units of dir. Nearer child first; leaf children are tested
 // as soon as their box is hit, interior ones descended into (the nearer) or pushed.
-fn trace_closest(origin: vec3<f32>, dir: vec3<f32>, tmax: f32) -> Hit {
+fn trace_closest(stack: ptr<function, WalkStack>, origin: vec3<f32>, dir: vec3<f32>, tmax: f32) -> Hit {
     var hit = Hit(tmax, NO_HIT, 0.0, 0.0);
     if (all(dir == vec3<f32>(0.0))) {
         return hit;
     }
     let r = make_ray(origin, dir);
-    var stack: array<u32, STACK_SIZE>;
     var sp = 0u;
     var node = 0u;
     loop {
@@ -277,7 +284,7 @@ fn trace_closest(origin: vec3<f32>, dir: vec3<f32>, tmax: f32) -> Hit {
             } else if (next == NO_HIT) {
                 next = i1;
             } else {
-                stack[sp] = i1;
+                (*stack)[sp] = i1;
                 sp += 1u;
             }
         }
@@ -286,7 +293,7 @@ fn trace_closest(origin: vec3<f32>, dir: vec3<f32>, tmax: f32) -> Hit {
                 break;
             }
             sp -= 1u;
-            next = stack[sp];
+            next = (*stack)[sp];
         }
         node = next;
     }
@@ -303,12 +310,11 @@ fn trace_closest(origin: vec3<f32>, dir: vec3<f32>, tmax: f32) -> Hit {
 // the larger box first, attempt 41, which was 9-15% faster than the split's order).
 // With `boxes` (imperfect visibility), a triangle whose box the segment crosses counts
 // as a hit (see box_crossed).
-fn trace_shadow(origin: vec3<f32>, dir: vec3<f32>, tmax: f32, boxes: bool) -> bool {
+fn trace_shadow(stack: ptr<function, WalkStack>, origin: vec3<f32>, dir: vec3<f32>, tmax: f32, boxes: bool) -> bool {
     if (all(dir == vec3<f32>(0.0))) {
         return false;
     }
     let r = make_ray(origin, dir);
-    var stack: array<u32, STACK_SIZE>;
     var sp = 0u;
     var node = 0u;
     loop {
@@ -333,7 +339,7 @@ fn trace_shadow(origin: vec3<f32>, dir: vec3<f32>, tmax: f32, boxes: bool) -> bo
             } else if (next == NO_HIT) {
                 next = n.b_index;
             } else {
-                stack[sp] = n.b_index;
+                (*stack)[sp] = n.b_index;
                 sp += 1u;
             }
         }
@@ -342,7 +348,7 @@ fn trace_shadow(origin: vec3<f32>, dir: vec3<f32>, tmax: f32, boxes: bool) -> bo
                 return false;
             }
             sp -= 1u;
-            next = stack[sp];
+            next = (*stack)[sp];
         }
         node = next;
     }
@@ -350,8 +356,8 @@ fn trace_shadow(origin: vec3<f32>, dir: vec3<f32>, tmax: f32, boxes: bool) -> bo
 }
 
 // Exact any-hit query (see trace_shadow).
-fn trace_any(origin: vec3<f32>, dir: vec3<f32>, tmax: f32) -> bool {
-    return trace_shadow(origin, dir, tmax, false);
+fn trace_any(stack: ptr<function, WalkStack>, origin: vec3<f32>, dir: vec3<f32>, tmax: f32) -> bool {
+    return trace_shadow(stack, origin, dir, tmax, false);
 }
 
 // Origin for a ray leaving a surface at p, n the unit geometric normal on the side the

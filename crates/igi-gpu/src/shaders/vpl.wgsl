@@ -87,9 +87,10 @@ fn shoot_path(path: u32) -> u32 {
     var dim = 3u;
     // Mirror reflections store nothing, so the walk is bounded separately.
     let max_segments = params.bounces + params.mirror_depth;
+    var stack: WalkStack;
     var traced = 0u;
     for (var segment = 0u; segment < max_segments; segment += 1u) {
-        let hit = trace_closest(origin, dir, INFINITY);
+        let hit = trace_closest(&stack, origin, dir, INFINITY);
         traced += 1u;
         if (hit.tri == NO_HIT) {
             break;
