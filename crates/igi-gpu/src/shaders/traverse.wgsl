@@ -24,10 +24,10 @@ const STACK_SIZE: u32 = 60u;
 
 // The traversal stack. The walks take it by pointer from their caller, which declares
 // one per invocation, outside its loops over rays: WGSL zero-initialises a function's
-// variables where they are declared (naga writes the null initializer, and the driver
-// stores it), so a stack declared in trace_shadow cost every walk 240 bytes of stores:
-// 2.6% of a canonical frame on the H200 (docs/PERFORMANCE.md attempt 89). A walk never
-// reads an entry it did not push, so one stack serves any number of walks.
+// variables where they are declared (naga writes a null initializer, which the NVIDIA
+// driver did not remove), so a stack declared in trace_shadow cost every walk 240 bytes
+// of stores: 2.6% of a canonical frame on the H200 (docs/PERFORMANCE.md attempt 89). A
+// walk never reads an entry it did not push, so one stack serves any number of walks.
 alias WalkStack = array<u32, STACK_SIZE>;
 
 // Direction components below this count as zero for the slab test (parallel axes).
