@@ -719,7 +719,7 @@ fn larger_first(a: BvhChild, b: BvhChild) -> BvhNode {
 }
 
 /// The box around two children's boxes.
-fn union(a: &BvhChild, b: &BvhChild) -> Aabb {
+pub(super) fn union(a: &BvhChild, b: &BvhChild) -> Aabb {
     Aabb {
         lo: Vec3A::from(a.min.min(b.min)),
         hi: Vec3A::from(a.max.max(b.max)),

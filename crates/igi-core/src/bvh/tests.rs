@@ -164,13 +164,7 @@ fn content(bvh: &Bvh, c: &BvhChild) -> (f32, f32) {
     if c.count == 0 {
         let n = bvh.nodes[c.index as usize];
         let ((area_a, cost_a), (area_b, cost_b)) = (content(bvh, &n.a()), content(bvh, &n.b()));
-        let union = BvhChild {
-            min: n.a().min.min(n.b().min),
-            max: n.a().max.max(n.b().max),
-            index: 0,
-            count: 0,
-        };
-        let visit = SAH_TRAVERSAL_COST * union.half_area();
+        let visit = SAH_TRAVERSAL_COST * build::union(&n.a(), &n.b()).half_area();
         return (area_a + area_b, visit + cost_a + cost_b);
     }
     let area = (c.index..c.index + c.count)
