@@ -1009,3 +1009,48 @@ fn split_build_tests_fewer_triangles_on_slivers() {
     assert!(st * 2 < bt, "triangle tests {bt} -> {st}");
     assert!(split.build_stats.sah_cost < binned.build_stats.sah_cost);
 }
+
+#[test]
+fn rays_through_tile_corners_far_from_the_origin_hit() {
+    // A floor of axis-aligned square tiles (flat leaf boxes) far from the world origin,
+    // and segments from far-off origins ending beyond the floor, aimed exactly at tile
+    // corners: every such point lies on the boxes' boundaries on both floor axes. The
+    // slab test's distances are fma(b, inv, -o inv) (SLAB_PAD): the rounding of o inv is
+    // an absolute error of the plane distances, here far above the relative margin of
+    // BOX_TFAR_SCALE, so without the pad boxes are missed by an ulp and rays pass
+    // between the tiles (this test fails with SLAB_PAD = 0); watertight triangle tests
+    // count corner hits. The exact form (b - o) inv that the fma replaced failed it too,
+    // in a closest hit: a tile's entry distance rounded one ulp above the hit found so
+    // far, so the walk pruned it and returned a hit one ulp farther than brute force.
+    let mut r = rng(21);
+    for &(base, tile) in &[(1.0e5f32, 1.0f32), (3.0e6, 16.0), (-2.5e5, 0.25)] {
+        let n = 24;
+        let corner = |i: usize, j: usize| {
+            Vec3::new(base + i as f32 * tile, -base * 0.5, base + j as f32 * tile)
+        };
+        let mut tris = vec![];
+        for i in 0..n {
+            for j in 0..n {
+                let (a, b, c, d) = (
+                    corner(i, j),
+                    corner(i + 1, j),
+                    corner(i + 1, j + 1),
+                    corner(i, j + 1),
+                );
+                tris.push([a, b, c]);
+                tris.push([a, c, d]);
+            }
+        }
+        let bvh = Bvh::build_from_vertices(&tris);
+        for _ in 0..4000 {
+            let target = corner(r.random_range(1..n), r.random_range(1..n));
+            let side = rand_vec(&mut r, -60.0, 60.0) * tile;
+            let above = r.random_range(3.0..90.0) * tile;
+            let o = target + Vec3::new(side.x, above, side.z);
+            // tmax 2: the segment ends as far below the floor as it starts above.
+            let d = target - o;
+            assert!(bvh.trace_any(o, d, 2.0), "any hit: {o} -> {target}");
+            check_ray(&bvh, &tris, o, d, 2.0);
+        }
+    }
+}

@@ -22,9 +22,9 @@ pub const NO_HIT: u32 = 0xffff_ffff;
 /// or outside the slab, but an origin on a plane (the ray runs inside the closed slab, as
 /// rays along a wall do) gives an exit distance of 0: the box would be missed. So the
 /// planes of a parallel axis are measured from an origin moved by the slack
-/// s = (|o| + 1) [`PARALLEL_SLACK`] (a relative 2^-20, far above the rounding of o + s):
-/// entry planes from o + s, exit planes from o - s ([`TraceRay::origin_lo`] and
-/// `origin_hi`). The ray then tests the slab [min - s, max + s]: inside it the entry
+/// s = (|o| + 1) [`PARALLEL_SLACK`] (a relative 2^-20, far above the rounding of o + s
+/// and of (o + s) 1e30): entry planes from o + s, exit planes from o - s (folded into
+/// [`TraceRay::c_min`] and `c_max`). The ray then tests the slab [min - s, max + s]: inside it the entry
 /// distance is <= -s 1e30 and the exit distance >= s 1e30 >= 9.5e23, beyond every box a
 /// ray can reach unless its direction is shorter than 1e-24 x the scene's extent and its
 /// length unbounded; outside it the box is missed, or visited for nothing when the origin
@@ -44,11 +44,32 @@ pub(crate) const PARALLEL_INV: f32 = 1e30;
 /// Relative widening of the slab of a parallel axis (see [`DIR_EPS`]): 2^-20.
 pub(crate) const PARALLEL_SLACK: f32 = 1.0 / 1_048_576.0;
 
+/// Relative pad of the slab test's per-ray offsets: 2^-21.
+///
+/// [`box_span`] computes the distance to a plane b of axis k as one fused multiply-add,
+/// t = fma(b, inv_k, c) with c = -o_k inv_k precomputed per ray, instead of
+/// (b - o_k) inv_k: a subtraction fewer for each of a box's six planes (the walks are
+/// bound by the arithmetic of their box tests; docs/PERFORMANCE.md attempt 93). The
+/// exact (b - o_k) inv_k needs no absolute error bound, since b - o_k is exact where b
+/// and o_k are close (Sterbenz). The fma form carries absolute errors that do not shrink
+/// with t: the rounding of o_k inv_k and of c's pad, each at most 2^-24 |o_k inv_k|, and
+/// one more of 2^-24 (|o_k inv_k| + |t|) where a compiler evaluates the fma as a product
+/// and a sum. So c moves each plane outward by 2^-21 |o_k inv_k|, 8 times 2^-24 (entry
+/// planes down, exit planes up, by the sign of inv_k), and the relative errors (the
+/// reciprocal, the fma's own rounding) stay covered by [`BOX_TFAR_SCALE`]. In space the
+/// pad widens a box by 2^-21 |o_k| along axis k: a few ulps of the origin's coordinate,
+/// so the walk visits no more boxes in practice and only ever more, never fewer, than the
+/// exact test (the answers are the triangle tests'). Parallel axes get no pad: their
+/// planes are 1e30 (b - o -+ s), whose rounding errors (2^-24 1e30 |o|) the slack
+/// (2^-20 1e30 (|o| + 1)) covers at least 8 times over.
+pub(crate) const SLAB_PAD: f32 = 1.0 / 2_097_152.0;
+
 /// Conservative rounding factor for the far end of a slab: 1 + 2 gamma(3) with
 /// gamma(n) = n eps / (1 - n eps), eps = 2^-24 (pbrt-v3/v4 `Bounds3::IntersectP`, Ize
-/// 2013). The slab distances (b - o) * inv carry three roundings (subtraction, reciprocal,
-/// product), so scaling t_far by this factor keeps every box the exact arithmetic would
-/// hit. 1 + 3 ulp(1) = 1.00000035762786865234375 is the f32 nearest to
+/// 2013). The slab distances fma(b, inv, c) carry at most three relative roundings (the
+/// reciprocal, the product and the sum where the fma is not fused; [`SLAB_PAD`] takes the
+/// absolute ones), so scaling t_far by this factor keeps every box the exact arithmetic
+/// would hit. 1 + 3 ulp(1) = 1.00000035762786865234375 is the f32 nearest to
 /// 1 + 2 gamma(3) = 1.0000003576...; traverse.wgsl writes the same value as a literal.
 /// The bound assumes a correctly rounded reciprocal (CPU, lavapipe); WGSL allows 2.5 ulp
 /// for division, which would need 1 + 2 gamma(7) to be strictly covered.
@@ -88,11 +109,11 @@ pub(crate) struct TraceRay {
     kz: usize,
     /// Shear constants (Sx, Sy, Sz) = (dir[kx] / dir[kz], dir[ky] / dir[kz], 1 / dir[kz]).
     shear: Vec3,
-    /// The origin the slab test measures entry planes from: `origin`, moved by
-    /// [`PARALLEL_SLACK`] (|o| + 1) along the parallel axes (see [`DIR_EPS`]).
-    origin_lo: Vec3,
-    /// The same for exit planes, moved the other way.
-    origin_hi: Vec3,
+    /// The slab test's offset for the planes of a box's `min` corner: a plane b is
+    /// crossed at t = fma(b, inv_dir, c) (see [`box_span`] and [`SLAB_PAD`]).
+    c_min: Vec3,
+    /// The same for the planes of the `max` corner.
+    c_max: Vec3,
 }
 
 impl TraceRay {
@@ -132,9 +153,22 @@ impl TraceRay {
                 0.0
             }
         }));
+        let oi = origin * inv_dir;
+        let pad = Vec3::from_array([0, 1, 2].map(|k| {
+            if parallel[k] {
+                0.0
+            } else {
+                oi[k].abs() * SLAB_PAD
+            }
+        }));
+        // The min corner's planes are the entry planes where inv_dir > 0 (parallel axes
+        // included: measured from o + s, see DIR_EPS) and move down by the pad; where
+        // inv_dir < 0 they are the exit planes and move up. The max corner's the other
+        // way (exit planes of parallel axes from o - s).
+        let positive = inv_dir.cmpgt(Vec3::ZERO);
         Some(TraceRay {
-            origin_lo: origin + slack,
-            origin_hi: origin - slack,
+            c_min: Vec3::select(positive, -(origin + slack) * inv_dir - pad, pad - oi),
+            c_max: Vec3::select(positive, -(origin - slack) * inv_dir + pad, -oi - pad),
             origin,
             inv_dir,
             kx,
@@ -151,12 +185,13 @@ impl TraceRay {
 /// instead, the NVIDIA driver spilled 12 bytes a thread of the GPU's gather to shared
 /// memory and the gathers ran 3.5% slower, docs/PERFORMANCE.md attempt 81). So the child
 /// no ray may hit is a point box at +inf ([`super::BvhChild::EMPTY`]), not an inverted
-/// one, and the walks' tmax is finite ([`finite_tmax`]). Parallel axes need no case of
-/// their own: their planes are measured from the moved origins (see [`DIR_EPS`]).
+/// one, and the walks' tmax is finite ([`finite_tmax`]). Each plane's distance is one
+/// fused multiply-add with the ray's padded offsets (see [`SLAB_PAD`]). Parallel axes
+/// need no case of their own: their offsets hold the moved origins (see [`DIR_EPS`]).
 #[inline]
 fn box_span(min: [f32; 3], max: [f32; 3], r: &TraceRay, tmax: f32) -> (f32, f32) {
-    let t0 = (Vec3::from(min) - r.origin_lo) * r.inv_dir;
-    let t1 = (Vec3::from(max) - r.origin_hi) * r.inv_dir;
+    let t0 = Vec3::from(min).mul_add(r.inv_dir, r.c_min);
+    let t1 = Vec3::from(max).mul_add(r.inv_dir, r.c_max);
     let tn = t0.min(t1);
     let tf = t0.max(t1);
     let near = tn.x.max(tn.y).max(tn.z.max(0.0));

@@ -38,6 +38,8 @@ const PARALLEL_INV: f32 = 1e30;
 // (2^-20) on both sides, so that an origin on its plane is inside (igi_core's DIR_EPS
 // says why and what it costs).
 const PARALLEL_SLACK: f32 = 0.00000095367431640625;
+// Relative pad of box_span's per-ray plane offsets (2^-21; igi_core's SLAB_PAD).
+const SLAB_PAD: f32 = 0.000000476837158203125;
 // A distance beyond every real one (box_crossed's parallel axes).
 const FAR_BIG: f32 = 1e38;
 // 1 + 2 gamma(3), rounded to f32 (1 + 3 ulp): conservative far end of a slab.
@@ -69,10 +71,11 @@ struct TraceRay {
     kz: u32,
     // |dir| < DIR_EPS: the ray is parallel to that axis' slab (box_crossed).
     parallel: vec3<bool>,
-    // The origins box_span measures entry (origin_lo) and exit (origin_hi) planes from:
-    // `origin`, moved by the slack of PARALLEL_SLACK along parallel axes.
-    origin_lo: vec3<f32>,
-    origin_hi: vec3<f32>,
+    // box_span's offsets for the planes of a box's min corner and of its max corner: a
+    // plane b is crossed at t = fma(b, inv_dir, c), c being -origin inv_dir moved outward
+    // by SLAB_PAD, from the origin moved by the slack along parallel axes.
+    c_min: vec3<f32>,
+    c_max: vec3<f32>,
 }
 
 // The shadow ray of a segment between two surface points (see shadow_segment).
@@ -103,7 +106,18 @@ fn make_ray(origin: vec3<f32>, dir: vec3<f32>) -> TraceRay {
     }
     let shear = vec3<f32>(dir[kx] / dir[kz], dir[ky] / dir[kz], 1.0 / dir[kz]);
     let slack = select(vec3<f32>(0.0), (abs(origin) + 1.0) * PARALLEL_SLACK, parallel);
-    return TraceRay(origin, inv_dir, shear, kx, ky, kz, parallel, origin + slack, origin - slack);
+    let oi = origin * inv_dir;
+    let pad = select(abs(oi) * SLAB_PAD, vec3<f32>(0.0), parallel);
+    // The min corner's planes are entry planes where inv_dir > 0 (parallel axes
+    // included: measured from the origin moved up by the slack, and moved down by the
+    // pad), exit planes where it is < 0 (moved up by the pad); the max corner's the
+    // other way. Written otherwise, as selects between -(origin -+ slack) inv_dir -+ pad
+    // computed first (the same values), the NVIDIA driver made the canonical frame's
+    // gather 2% slower (docs/PERFORMANCE.md attempt 93).
+    let positive = inv_dir > vec3<f32>(0.0);
+    let c_min = select(pad - oi, -(origin + slack) * inv_dir - pad, positive);
+    let c_max = select(-oi - pad, -(origin - slack) * inv_dir + pad, positive);
+    return TraceRay(origin, inv_dir, shear, kx, ky, kz, parallel, c_min, c_max);
 }
 
 // Slab test: (entry, exit) distances of a box clipped to [0, tmax]; the box is hit when
@@ -112,11 +126,14 @@ fn make_ray(origin: vec3<f32>, dir: vec3<f32>) -> TraceRay {
 // thread of the gather to shared memory and the gathers ran 3.5% slower,
 // docs/PERFORMANCE.md attempt 81). So the child no ray may hit is a point box at +inf,
 // not an inverted one (igi_core's BvhChild::EMPTY); tmax is always finite here (WGSL has
-// no infinity). Parallel axes need no case of their own: their planes are measured from
-// the moved origins (the select this replaced cost 6-10% of every walk, attempt 35).
+// no infinity). Each plane's distance is one fused multiply-add with the ray's padded
+// offsets (igi_core's SLAB_PAD says why that stays conservative; one subtraction fewer
+// per plane than (b - o) * inv made canonical frames 2.3% faster, attempt 93). Parallel
+// axes need no case of their own: their offsets hold the moved origins (the select this
+// replaced cost 6-10% of every walk, attempt 35).
 fn box_span(bmin: vec3<f32>, bmax: vec3<f32>, r: TraceRay, tmax: f32) -> vec2<f32> {
-    let t0 = (bmin - r.origin_lo) * r.inv_dir;
-    let t1 = (bmax - r.origin_hi) * r.inv_dir;
+    let t0 = fma(bmin, r.inv_dir, r.c_min);
+    let t1 = fma(bmax, r.inv_dir, r.c_max);
     let tn = min(t0, t1);
     let tf = max(t0, t1);
     let near = max(max(tn.x, tn.y), max(tn.z, 0.0));
