@@ -7,12 +7,23 @@
 //! default builder `BvhBuilder::Split`; `--binned` measures `BvhBuilder::Binned`). An OBJ is read as bare
 //! triangles with `tobj`, every face kept (the scene loader may drop degenerate ones).
 
+use std::io::Write;
 use std::path::PathBuf;
 use std::time::Instant;
 
 use igi_core::bvh::{Bvh, BvhBuilder};
 use igi_core::scene::{load_scene, Triangle};
 use igi_core::Vec3;
+
+/// println! that stops quietly when stdout is closed (`bvh_build | head -3`) instead of
+/// panicking, as the `igi` command does.
+macro_rules! out {
+    ($($arg:tt)*) => {
+        if writeln!(std::io::stdout(), $($arg)*).is_err() {
+            std::process::exit(0);
+        }
+    };
+}
 
 fn main() {
     let builder = if std::env::args().any(|a| a == "--binned") {
@@ -43,14 +54,14 @@ fn main() {
         Some(s) => s.triangles.clone(),
         None => load_obj(&path),
     };
-    println!(
+    out!(
         "{}: {} triangles (loaded in {:.0} ms)",
         path.display(),
         triangles.len(),
         t.elapsed().as_secs_f64() * 1e3
     );
-    println!("builder: {}", builder.name());
-    println!(
+    out!("builder: {}", builder.name());
+    out!(
         "threads: {}",
         std::thread::available_parallelism().map_or(1, |n| n.get())
     );
@@ -72,15 +83,15 @@ fn main() {
     let s = &bvh.build_stats;
     if let Some(cpu) = cpu {
         // Less sensitive than wall time to other processes on a small machine.
-        println!("CPU time per build, all threads: {:.0} ms", cpu * 1e3);
+        out!("CPU time per build, all threads: {:.0} ms", cpu * 1e3);
     }
-    println!(
+    out!(
         "build: median {:.1} ms of {runs} (min {:.1}, max {:.1})",
         times[runs / 2],
         times[0],
         times[runs - 1]
     );
-    println!(
+    out!(
         "references {}, nodes {} ({} KiB), leaves {}, max depth {}, max leaf {}, oversized leaves {}, SAH cost {:.2}",
         s.references,
         s.nodes,
@@ -109,7 +120,7 @@ fn main() {
         }
     }
     let secs = t.elapsed().as_secs_f64();
-    println!(
+    out!(
         "CPU closest hit, {w}x{h} camera rays on one thread: {:.2} Mrays/s, {:.1}% hit",
         (w * h) as f64 / secs / 1e6,
         100.0 * hit_points.len() as f64 / (w * h) as f64
@@ -124,7 +135,7 @@ fn main() {
             rays += 1;
         }
     }
-    println!(
+    out!(
         "CPU any hit, {rays} shadow rays from those hits to the lights on one thread: {:.2} Mrays/s, {:.1}% occluded",
         rays as f64 / t.elapsed().as_secs_f64() / 1e6,
         100.0 * occluded as f64 / rays as f64
