@@ -24,10 +24,10 @@ pub const NO_HIT: u32 = 0xffff_ffff;
 /// planes of a parallel axis are measured from an origin moved by the slack
 /// s = (|o| + 1) [`PARALLEL_SLACK`] (a relative 2^-20, far above the rounding of o + s
 /// and of (o + s) 1e30): entry planes from o + s, exit planes from o - s (folded into
-/// [`TraceRay::c_min`] and `c_max`). The ray then tests the slab [min - s, max + s]: inside it the entry
-/// distance is <= -s 1e30 and the exit distance >= s 1e30 >= 9.5e23, beyond every box a
-/// ray can reach unless its direction is shorter than 1e-24 x the scene's extent and its
-/// length unbounded; outside it the box is missed, or visited for nothing when the origin
+/// [`TraceRay::c_min`] and `c_max`). The ray then tests the slab [min - s, max + s]:
+/// inside it the entry distance is <= -s 1e30 and the exit distance >= s 1e30 >= 9.5e23,
+/// beyond every box a ray can reach unless its direction is shorter than 1e-24 x the
+/// scene's extent and its length unbounded; outside it the box is missed, or visited for nothing when the origin
 /// lies within 1e-23 of the widened slab (conservative). This costs the slab test
 /// nothing per box; the select that replaced exit distances >= 0 of parallel axes by a
 /// large value did, 6-10% of every walk (docs/PERFORMANCE.md attempt 35). Boxes only get
@@ -57,9 +57,9 @@ pub(crate) const PARALLEL_SLACK: f32 = 1.0 / 1_048_576.0;
 /// and a sum. So c moves each plane outward by 2^-21 |o_k inv_k|, 8 times 2^-24 (entry
 /// planes down, exit planes up, by the sign of inv_k), and the relative errors (the
 /// reciprocal, the fma's own rounding) stay covered by [`BOX_TFAR_SCALE`]. In space the
-/// pad widens a box by 2^-21 |o_k| along axis k: a few ulps of the origin's coordinate,
-/// so the walk visits no more boxes in practice and only ever more, never fewer, than the
-/// exact test (the answers are the triangle tests'). Parallel axes get no pad: their
+/// pad widens a box by 2^-21 |o_k| along axis k, a few ulps of the origin's coordinate:
+/// in practice the walk visits the boxes the exact test would, and it can only ever
+/// visit more, never fewer (the answers are the triangle tests'). Parallel axes get no pad: their
 /// planes are 1e30 (b - o -+ s), whose rounding errors (2^-24 1e30 |o|) the slack
 /// (2^-20 1e30 (|o| + 1)) covers at least 8 times over.
 pub(crate) const SLAB_PAD: f32 = 1.0 / 2_097_152.0;
