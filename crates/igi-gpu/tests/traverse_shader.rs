@@ -76,8 +76,6 @@ fn constants_match_the_cpu_twin() {
     assert_eq!(f("PARALLEL_INV"), 1e30);
     assert_eq!(f("PARALLEL_SLACK"), 1.0 / 1_048_576.0);
     assert_eq!(f("SLAB_PAD"), 1.0 / 2_097_152.0);
-    // Used by the GPU's box_crossed only (imperfect visibility has no CPU twin).
-    assert_eq!(f("FAR_BIG"), 1e38);
     assert_eq!(f("OFFSET_ORIGIN"), 1.0 / 32.0);
     assert_eq!(f("OFFSET_FLOAT_SCALE"), 1.0 / 65536.0);
     assert_eq!(f("OFFSET_INT_SCALE"), 256.0);

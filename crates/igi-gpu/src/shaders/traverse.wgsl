@@ -40,8 +40,6 @@ const PARALLEL_INV: f32 = 1e30;
 const PARALLEL_SLACK: f32 = 0.00000095367431640625;
 // Relative pad of box_span's per-ray plane offsets (2^-21; igi_core's SLAB_PAD).
 const SLAB_PAD: f32 = 0.000000476837158203125;
-// A distance beyond every real one (box_crossed's parallel axes).
-const FAR_BIG: f32 = 1e38;
 // 1 + 2 gamma(3), rounded to f32 (1 + 3 ulp): conservative far end of a slab.
 const BOX_TFAR_SCALE: f32 = 1.0000003576278687;
 
@@ -69,8 +67,6 @@ struct TraceRay {
     kx: u32,
     ky: u32,
     kz: u32,
-    // |dir| < DIR_EPS: the ray is parallel to that axis' slab (box_crossed).
-    parallel: vec3<bool>,
     // box_span's offsets for the planes of a box's min corner and of its max corner: a
     // plane b is crossed at t = fma(b, inv_dir, c), c being -origin inv_dir moved outward
     // by SLAB_PAD, from the origin moved by the slack along parallel axes.
@@ -117,7 +113,22 @@ fn make_ray(origin: vec3<f32>, dir: vec3<f32>) -> TraceRay {
     let positive = inv_dir > vec3<f32>(0.0);
     let c_min = select(pad - oi, -(origin + slack) * inv_dir - pad, positive);
     let c_max = select(-oi - pad, -(origin - slack) * inv_dir + pad, positive);
-    return TraceRay(origin, inv_dir, shear, kx, ky, kz, parallel, c_min, c_max);
+    return TraceRay(origin, inv_dir, shear, kx, ky, kz, c_min, c_max);
+}
+
+// Where the ray crosses a box's slabs: per axis the nearer and the farther plane's
+// distance, each one fused multiply-add with the ray's padded offsets (box_span says
+// why). Both box tests take their distances from here: box_span for the walks,
+// box_crossed for imperfect visibility.
+struct SlabSpans {
+    near: vec3<f32>,
+    far: vec3<f32>,
+}
+
+fn slab_spans(bmin: vec3<f32>, bmax: vec3<f32>, r: TraceRay) -> SlabSpans {
+    let t0 = fma(bmin, r.inv_dir, r.c_min);
+    let t1 = fma(bmax, r.inv_dir, r.c_max);
+    return SlabSpans(min(t0, t1), max(t0, t1));
 }
 
 // Slab test: (entry, exit) distances of a box clipped to [0, tmax]; the box is hit when
@@ -132,10 +143,9 @@ fn make_ray(origin: vec3<f32>, dir: vec3<f32>) -> TraceRay {
 // axes need no case of their own: their offsets hold the moved origins (the select this
 // replaced cost 6-10% of every walk, attempt 35).
 fn box_span(bmin: vec3<f32>, bmax: vec3<f32>, r: TraceRay, tmax: f32) -> vec2<f32> {
-    let t0 = fma(bmin, r.inv_dir, r.c_min);
-    let t1 = fma(bmax, r.inv_dir, r.c_max);
-    let tn = min(t0, t1);
-    let tf = max(t0, t1);
+    let slabs = slab_spans(bmin, bmax, r);
+    let tn = slabs.near;
+    let tf = slabs.far;
     let near = max(max(tn.x, tn.y), max(tn.z, 0.0));
     let far = min(min(min(tf.x, tf.y), tf.z) * BOX_TFAR_SCALE, tmax);
     return vec2<f32>(near, far);
@@ -248,18 +258,14 @@ const BOX_MARGIN: f32 = 1e-4;
 // origin, and ends inside those around the VPL, so counting them would make every
 // oblique (or axis-aligned, whose box is flat) surface shadow itself. Such triangles get
 // the exact test instead, so boxes only ever add occlusion to the exact answer.
+// The distances are box_span's, unclipped: a parallel axis's planes are measured from
+// the origin moved by its slack, so that inside the slab they lie beyond +-9.5e23 and
+// the other axes decide, and outside it the box is missed (igi_core's DIR_EPS); the
+// pads widen the box by a few ulps of the origin, far below BOX_MARGIN.
 fn box_crossed(bmin: vec3<f32>, bmax: vec3<f32>, r: TraceRay, tmax: f32) -> bool {
-    let t0 = (bmin - r.origin) * r.inv_dir;
-    let t1 = (bmax - r.origin) * r.inv_dir;
-    // Nearer and farther plane by min and max, as in box_span.
-    var tn = min(t0, t1);
-    var tf = max(t0, t1);
-    // A parallel axis: inside the slab (any t) or never.
-    let inside = r.origin >= bmin & r.origin <= bmax;
-    tn = select(tn, select(vec3<f32>(FAR_BIG), vec3<f32>(-FAR_BIG), inside), r.parallel);
-    tf = select(tf, select(vec3<f32>(-FAR_BIG), vec3<f32>(FAR_BIG), inside), r.parallel);
-    let enter = max(max(tn.x, tn.y), tn.z);
-    let leave = min(min(tf.x, tf.y), tf.z);
+    let slabs = slab_spans(bmin, bmax, r);
+    let enter = max(max(slabs.near.x, slabs.near.y), slabs.near.z);
+    let leave = min(min(slabs.far.x, slabs.far.y), slabs.far.z);
     return enter <= leave && enter > BOX_MARGIN && leave < tmax - BOX_MARGIN;
 }
 
