@@ -47,8 +47,14 @@ pub use traverse::{
 pub const MAX_DEPTH: u32 = 60;
 
 /// Largest leaf the SAH may choose; larger ranges are always split (unless they reach
-/// [`MAX_DEPTH`]). Small leaves keep the work of neighbouring GPU threads similar.
-pub const MAX_LEAF_SIZE: usize = 4;
+/// [`MAX_DEPTH`]). Small leaves keep the work of neighbouring GPU threads similar, and a
+/// triangle test costs the walks more than its share of the SAH: on the H200 (conference
+/// room, split BVH; docs/PERFORMANCE.md attempt 97) 3 instead of 4 made the random
+/// segments 2.168 -> 2.219 G rays/s, closest hits 1.808 -> 1.897, canonical frames 9.88
+/// -> 9.83 ms, for 6% more nodes and no measurable build time; 2 did about as well on
+/// the rays and slightly worse on the frames, for 24% more nodes and 5% more build time;
+/// 1 was slower everywhere.
+pub const MAX_LEAF_SIZE: usize = 3;
 
 /// Number of bins per axis for the SAH split search.
 pub const SAH_BINS: usize = 16;
