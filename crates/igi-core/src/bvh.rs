@@ -84,7 +84,7 @@ pub const SAH_INTERSECT_COST: f32 = 1.0;
 /// Child a is the likelier occluder per unit of work: the larger ratio of triangle area
 /// below it to the SAH cost of the interior nodes below it (any-hit walks visit it first,
 /// see `build`). Leaf triangles are BVH slots `index .. index + count` of
-/// [`Bvh::tri_verts`]. An empty child (the second child of a root that is a single leaf,
+/// [`Bvh::tri_rows`]. An empty child (the second child of a root that is a single leaf,
 /// both children of the BVH of no triangles) has min = max = +inf, count 1, index 0:
 /// [`BvhChild::EMPTY`], a box no ray with a finite tmax hits.
 #[repr(C)]
@@ -229,8 +229,11 @@ pub struct BuildStats {
 pub struct Bvh {
     /// Interior nodes; node 0 is the root.
     pub nodes: Vec<BvhNode>,
-    /// Three vertices per BVH slot (xyz, w = 0), in BVH order (slot i at 3i..3i+3).
-    pub tri_verts: Vec<[f32; 4]>,
+    /// Three rows per BVH slot, in BVH order (slot i at 3i..3i+3): the x, the y and the z
+    /// coordinates of its vertices 0, 1 and 2 (w = 0). The triangle test reads the rows of
+    /// the ray's Woop axes (kx, ky, kz) by index; stored as vertices, the coordinates had
+    /// to be permuted with 18 selects a test (docs/PERFORMANCE.md attempt 102).
+    pub tri_rows: Vec<[f32; 4]>,
     /// BVH slot -> index of the triangle in the slice given to the build. Each triangle
     /// has one slot, or more with [`BvhBuilder::Split`] (one per piece).
     pub tri_order: Vec<u32>,
@@ -277,14 +280,8 @@ impl Bvh {
     /// Vertices of the triangle in BVH slot `slot`.
     pub fn triangle(&self, slot: u32) -> [Vec3; 3] {
         let i = 3 * slot as usize;
-        let v = |k: usize| {
-            Vec3::new(
-                self.tri_verts[k][0],
-                self.tri_verts[k][1],
-                self.tri_verts[k][2],
-            )
-        };
-        [v(i), v(i + 1), v(i + 2)]
+        let (x, y, z) = (self.tri_rows[i], self.tri_rows[i + 1], self.tri_rows[i + 2]);
+        [0, 1, 2].map(|j| Vec3::new(x[j], y[j], z[j]))
     }
 
     /// Box of the whole scene (min, max); inverted-infinite for no triangles.

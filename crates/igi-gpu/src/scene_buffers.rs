@@ -1,4 +1,4 @@
-//! The scene on the GPU: BVH nodes, triangle vertices and shading data in BVH order,
+//! The scene on the GPU: BVH nodes, triangle rows and shading data in BVH order,
 //! materials and lights, as bind group 0 of every pass (`shaders/scene.wgsl`).
 
 use crate::context::{GpuContext, GpuError};
@@ -142,11 +142,7 @@ impl SceneBuffers {
         let lights = gpu_lights(&scene.lights);
         let buffers = [
             storage_buffer(ctx, "BVH nodes", bytemuck::cast_slice(&bvh.nodes))?,
-            storage_buffer(
-                ctx,
-                "triangle vertices",
-                bytemuck::cast_slice(&bvh.tri_verts),
-            )?,
+            storage_buffer(ctx, "triangle rows", bytemuck::cast_slice(&bvh.tri_rows))?,
             storage_buffer(ctx, "triangle shading", bytemuck::cast_slice(&shading))?,
             storage_buffer(ctx, "materials", bytemuck::cast_slice(&materials))?,
             storage_buffer(ctx, "lights", bytemuck::cast_slice(&lights))?,

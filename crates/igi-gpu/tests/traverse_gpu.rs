@@ -343,7 +343,7 @@ fn run_kernel(ctx: &GpuContext, bvh: &Bvh, rays: &[(TestRay, Kind)]) -> Vec<Test
         source: wgpu::ShaderSource::Wgsl(src.into()),
     });
     // Auto layout: bind group 0 gets only the scene bindings the kernel uses
-    // (bvh_nodes, tri_verts).
+    // (bvh_nodes, tri_rows).
     let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
         label: Some("traverse test"),
         layout: None,
@@ -364,9 +364,9 @@ fn run_kernel(ctx: &GpuContext, bvh: &Bvh, rays: &[(TestRay, Kind)]) -> Vec<Test
         bytemuck::cast_slice(&bvh.nodes),
         wgpu::BufferUsages::empty(),
     );
-    let verts = storage(
-        "tri_verts",
-        bytemuck::cast_slice(&bvh.tri_verts),
+    let rows = storage(
+        "tri_rows",
+        bytemuck::cast_slice(&bvh.tri_rows),
         wgpu::BufferUsages::empty(),
     );
     let ray_data: Vec<TestRay> = rays.iter().map(|(r, _)| *r).collect();
@@ -395,7 +395,7 @@ fn run_kernel(ctx: &GpuContext, bvh: &Bvh, rays: &[(TestRay, Kind)]) -> Vec<Test
             entries: &entries,
         })
     };
-    let scene_group = bind(0, &[&nodes, &verts]);
+    let scene_group = bind(0, &[&nodes, &rows]);
     let io_group = bind(1, &[&ray_buf, &out]);
     let mut encoder =
         device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });

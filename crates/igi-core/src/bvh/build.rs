@@ -332,7 +332,7 @@ where
     F: Fn(usize) -> [Vec3; 3] + Sync,
 {
     let start = Instant::now();
-    // The GPU indexes tri_verts with 3 * slot + 2 in u32.
+    // The GPU indexes tri_rows with 3 * slot + 2 in u32.
     assert!(
         count <= (u32::MAX / 3) as usize,
         "too many triangles for one BVH: {count}"
@@ -340,7 +340,7 @@ where
     if count == 0 {
         return Bvh {
             nodes: vec![BvhNode::new(BvhChild::EMPTY, BvhChild::EMPTY)],
-            tri_verts: vec![],
+            tri_rows: vec![],
             tri_order: vec![],
             build_stats: stats(0, 0, 1, Tally::default(), (0.0, 0), 0.0, start),
         };
@@ -391,12 +391,13 @@ where
     }
     drop(prims);
 
-    let mut tri_verts = vec![[0.0f32; 4]; 3 * refs];
-    par_chunks(&mut tri_verts, 3, |base, chunk| {
+    // Per slot the x, y and z rows of its vertices (see Bvh::tri_rows).
+    let mut tri_rows = vec![[0.0f32; 4]; 3 * refs];
+    par_chunks(&mut tri_rows, 3, |base, chunk| {
         for (k, out) in chunk.chunks_exact_mut(3).enumerate() {
-            let v = tri(ids[base / 3 + k] as usize);
-            for (o, v) in out.iter_mut().zip(v) {
-                *o = [v.x, v.y, v.z, 0.0];
+            let [v0, v1, v2] = tri(ids[base / 3 + k] as usize);
+            for (axis, o) in out.iter_mut().enumerate() {
+                *o = [v0[axis], v1[axis], v2[axis], 0.0];
             }
         }
     });
@@ -406,7 +407,7 @@ where
     // A binary tree of n leaves has n - 1 interior nodes (a root leaf still needs node 0).
     let interior = tally.leaves.max(2) - 1;
     let (mut nodes, interior_area, deepest) = depth_first_layout(&nodes, interior);
-    occluder_first(&mut nodes, &tri_verts);
+    occluder_first(&mut nodes, &tri_rows);
     let build_stats = stats(
         count,
         refs,
@@ -418,7 +419,7 @@ where
     );
     Bvh {
         nodes,
-        tri_verts,
+        tri_rows,
         tri_order: ids,
         build_stats,
     }
@@ -624,11 +625,12 @@ fn rotate_node(tree: &mut Region, i: usize, depth: u32, max_depth: u32) -> Optio
 /// are swapped, child b's subtree is the one right after the node: laying the tree out
 /// again so that child a's came first measured the same on the H200 (attempt 80) and cost
 /// the build 4-8 ms.
-fn occluder_first(nodes: &mut [BvhNode], tri_verts: &[[f32; 4]]) {
-    let mut slot_area = vec![0.0f32; tri_verts.len() / 3];
+fn occluder_first(nodes: &mut [BvhNode], tri_rows: &[[f32; 4]]) {
+    let mut slot_area = vec![0.0f32; tri_rows.len() / 3];
     par_chunks(&mut slot_area, 1, |base, chunk| {
         for (k, out) in chunk.iter_mut().enumerate() {
-            let v = |j: usize| Vec3A::from_slice(&tri_verts[3 * (base + k) + j][..3]);
+            let rows = &tri_rows[3 * (base + k)..3 * (base + k) + 3];
+            let v = |j: usize| Vec3A::new(rows[0][j], rows[1][j], rows[2][j]);
             let a = 0.5 * (v(1) - v(0)).cross(v(2) - v(0)).length();
             *out = if a.is_finite() { a } else { 0.0 };
         }

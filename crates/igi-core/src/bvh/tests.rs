@@ -43,7 +43,7 @@ fn random_triangles(r: &mut Pcg64, n: usize, extent: f32, size: f32) -> Vec<[Vec
         .collect()
 }
 
-/// Checks the structure: tri_order is a permutation, tri_verts follow it, every box
+/// Checks the structure: tri_order is a permutation, tri_rows follow it, every box
 /// contains what it holds, depth and stack bounds hold.
 fn check_structure(bvh: &Bvh, tris: &[[Vec3; 3]]) {
     check_structure_of(bvh, tris, BvhBuilder::Binned);
@@ -60,7 +60,7 @@ fn check_structure_of(bvh: &Bvh, tris: &[[Vec3; 3]], builder: BvhBuilder) {
     if builder == BvhBuilder::Binned {
         assert_eq!(refs, n);
     }
-    assert_eq!(bvh.tri_verts.len(), 3 * refs);
+    assert_eq!(bvh.tri_rows.len(), 3 * refs);
     let mut seen = vec![false; n];
     for (slot, &i) in bvh.tri_order.iter().enumerate() {
         assert!(
@@ -236,7 +236,7 @@ fn empty_bvh_misses_everything() {
     let bvh = Bvh::build(&[]);
     assert_eq!(bvh.nodes.len(), 1);
     assert_eq!((bvh.build_stats.leaves, bvh.build_stats.max_depth), (0, 0));
-    assert!(bvh.tri_verts.is_empty() && bvh.tri_order.is_empty());
+    assert!(bvh.tri_rows.is_empty() && bvh.tri_order.is_empty());
     let mut r = rng(1);
     for _ in 0..100 {
         let o = rand_vec(&mut r, -10.0, 10.0);
@@ -841,7 +841,7 @@ fn parallel_build_is_deterministic_and_correct() {
     let one = super::build::build_on_one_thread(&tris);
     assert_eq!(a.nodes, one.nodes);
     assert_eq!(a.tri_order, one.tri_order);
-    assert_eq!(a.tri_verts, one.tri_verts);
+    assert_eq!(a.tri_rows, one.tri_rows);
     check_structure(&a, &tris);
     for _ in 0..300 {
         let o = rand_vec(&mut r, -120.0, 120.0);

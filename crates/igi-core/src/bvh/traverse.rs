@@ -100,7 +100,8 @@ pub struct Hit {
 /// Per-ray data, computed once (`make_ray` in WGSL).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct TraceRay {
-    origin: Vec3,
+    /// The origin in the Woop axes: (origin[kx], origin[ky], origin[kz]).
+    origin_k: Vec3,
     inv_dir: Vec3,
     /// Woop et al.: kz is the axis of the largest |dir| component, (kx, ky) the other two
     /// in an order that keeps the triangles' winding.
@@ -169,7 +170,7 @@ impl TraceRay {
         Some(TraceRay {
             c_min: Vec3::select(positive, -(origin + slack) * inv_dir - pad, pad - oi),
             c_max: Vec3::select(positive, -(origin - slack) * inv_dir + pad, -oi - pad),
-            origin,
+            origin_k: Vec3::new(origin[kx], origin[ky], origin[kz]),
             inv_dir,
             kx,
             ky,
@@ -218,7 +219,11 @@ fn box_hit(min: [f32; 3], max: [f32; 3], r: &TraceRay, tmax: f32) -> bool {
 }
 
 /// Watertight ray-triangle test (Woop, Benthin, Wald, JCGT 2(1), 2013), two-sided.
-/// Returns (t, u, v) for a hit with 0 < t < tmax; u, v weigh v1 and v2.
+/// Returns (t, u, v) for a hit with 0 < t < tmax; u, v weigh v1 and v2. The triangle
+/// comes as its rows in the ray's Woop axes ([`woop_rows`]): `xr` holds the kx
+/// coordinates of v0, v1 and v2, `yr` the ky and `zr` the kz ones, so that the test
+/// needs no permutation of its own (the GPU reads them from [`Bvh::tri_rows`] by index;
+/// the values are those of the vertex form, (v - o)[kx] = v[kx] - o[kx]).
 ///
 /// Watertight: the vertices are translated to the ray origin and sheared so that the ray
 /// becomes the +z axis; a shared vertex gets the same 2D coordinates in every triangle,
@@ -236,24 +241,19 @@ fn box_hit(min: [f32; 3], max: [f32; 3], r: &TraceRay, tmax: f32) -> bool {
 /// by one rounding of the 2D products (a relative ~1e-7 of the triangle's extent seen
 /// from the origin), which no pass of igi can tell apart.
 #[inline]
-fn intersect_triangle(
-    r: &TraceRay,
-    v0: Vec3,
-    v1: Vec3,
-    v2: Vec3,
-    tmax: f32,
-) -> Option<(f32, f32, f32)> {
-    let a = v0 - r.origin;
-    let b = v1 - r.origin;
-    let c = v2 - r.origin;
-    let (kx, ky, kz) = (r.kx, r.ky, r.kz);
+fn intersect_triangle(r: &TraceRay, [xr, yr, zr]: [Vec3; 3], tmax: f32) -> Option<(f32, f32, f32)> {
+    // Per row the three vertices moved to the origin: dx = (a[kx], b[kx], c[kx]) of the
+    // translated vertices a, b, c, and so on.
+    let dx = xr - r.origin_k.x;
+    let dy = yr - r.origin_k.y;
+    let dz = zr - r.origin_k.z;
     let (sx, sy, sz) = (r.shear.x, r.shear.y, r.shear.z);
-    let ax = a[kx] - sx * a[kz];
-    let ay = a[ky] - sy * a[kz];
-    let bx = b[kx] - sx * b[kz];
-    let by = b[ky] - sy * b[kz];
-    let cx = c[kx] - sx * c[kz];
-    let cy = c[ky] - sy * c[kz];
+    let ax = dx.x - sx * dz.x;
+    let ay = dy.x - sy * dz.x;
+    let bx = dx.y - sx * dz.y;
+    let by = dy.y - sy * dz.y;
+    let cx = dx.z - sx * dz.z;
+    let cy = dy.z - sy * dz.z;
     // Edge functions U = cx by - cy bx (weight of v0), V (v1), W (v2), as product pairs.
     let (u1, u2) = (cx * by, cy * bx);
     let (v1_, v2_) = (ax * cy, ay * cx);
@@ -269,9 +269,9 @@ fn intersect_triangle(
     if det == 0.0 {
         return None; // the ray lies in the triangle's plane, or the triangle is degenerate
     }
-    let az = sz * a[kz];
-    let bz = sz * b[kz];
-    let cz = sz * c[kz];
+    let az = sz * dz.x;
+    let bz = sz * dz.y;
+    let cz = sz * dz.z;
     let tt = uu * az + vv * bz + ww * cz;
     let rcp = 1.0 / det;
     let t = tt * rcp;
@@ -282,22 +282,24 @@ fn intersect_triangle(
     }
 }
 
+/// The rows of BVH slot `slot` in the ray's Woop axes, read by index as the GPU does.
 #[inline]
-fn slot_vertices(bvh: &Bvh, slot: u32) -> (Vec3, Vec3, Vec3) {
+fn slot_rows(bvh: &Bvh, slot: u32, r: &TraceRay) -> [Vec3; 3] {
     let i = 3 * slot as usize;
-    let v = |k: usize| {
-        let p = bvh.tri_verts[k];
-        Vec3::new(p[0], p[1], p[2])
-    };
-    (v(i), v(i + 1), v(i + 2))
+    [r.kx, r.ky, r.kz].map(|k| Vec3::from_slice(&bvh.tri_rows[i + k][..3]))
+}
+
+/// The rows of a triangle given by its vertices, in the ray's Woop axes.
+#[inline]
+fn woop_rows(r: &TraceRay, [v0, v1, v2]: &[Vec3; 3]) -> [Vec3; 3] {
+    [r.kx, r.ky, r.kz].map(|k| Vec3::new(v0[k], v1[k], v2[k]))
 }
 
 /// Tests the triangles of a leaf in slot order; keeps the first of equal-distance hits.
 #[inline]
 fn leaf_closest(bvh: &Bvh, first: u32, count: u32, r: &TraceRay, hit: &mut Hit) {
     for slot in first..first + count {
-        let (v0, v1, v2) = slot_vertices(bvh, slot);
-        if let Some((t, u, v)) = intersect_triangle(r, v0, v1, v2, hit.t) {
+        if let Some((t, u, v)) = intersect_triangle(r, slot_rows(bvh, slot, r), hit.t) {
             *hit = Hit { t, tri: slot, u, v };
         }
     }
@@ -314,8 +316,7 @@ fn leaf_any(
 ) -> bool {
     (first..first + count).any(|slot| {
         counter.triangle();
-        let (v0, v1, v2) = slot_vertices(bvh, slot);
-        intersect_triangle(r, v0, v1, v2, tmax).is_some()
+        intersect_triangle(r, slot_rows(bvh, slot, r), tmax).is_some()
     })
 }
 
@@ -499,8 +500,8 @@ pub fn brute_force_closest(
     let r = TraceRay::new(origin, dir)?;
     let mut best = None;
     let mut t_best = tmax;
-    for (i, [v0, v1, v2]) in triangles.iter().enumerate() {
-        if let Some((t, _, _)) = intersect_triangle(&r, *v0, *v1, *v2, t_best) {
+    for (i, tri) in triangles.iter().enumerate() {
+        if let Some((t, _, _)) = intersect_triangle(&r, woop_rows(&r, tri), t_best) {
             best = Some((i as u32, t));
             t_best = t;
         }
@@ -515,7 +516,7 @@ pub fn brute_force_any(triangles: &[[Vec3; 3]], origin: Vec3, dir: Vec3, tmax: f
     };
     triangles
         .iter()
-        .any(|[v0, v1, v2]| intersect_triangle(&r, *v0, *v1, *v2, tmax).is_some())
+        .any(|tri| intersect_triangle(&r, woop_rows(&r, tri), tmax).is_some())
 }
 
 /// Origin for a ray leaving a surface at `p` (Wächter and Binder, "A Fast and Robust

@@ -88,9 +88,12 @@ struct SurfaceHit {
 
 fn surface_at(origin: vec3<f32>, dir: vec3<f32>, hit: Hit) -> SurfaceHit {
     var s: SurfaceHit;
-    let v0 = tri_verts[3u * hit.tri].xyz;
-    let v1 = tri_verts[3u * hit.tri + 1u].xyz;
-    let v2 = tri_verts[3u * hit.tri + 2u].xyz;
+    let x = tri_rows[3u * hit.tri].xyz;
+    let y = tri_rows[3u * hit.tri + 1u].xyz;
+    let z = tri_rows[3u * hit.tri + 2u].xyz;
+    let v0 = vec3<f32>(x.x, y.x, z.x);
+    let v1 = vec3<f32>(x.y, y.y, z.y);
+    let v2 = vec3<f32>(x.z, y.z, z.z);
     // Barycentric position: on the triangle, not origin + t dir, whose rounding can put
     // the point behind the surface.
     s.position = (1.0 - hit.u - hit.v) * v0 + hit.u * v1 + hit.v * v2;

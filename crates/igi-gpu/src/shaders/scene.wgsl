@@ -30,8 +30,10 @@ struct PointLight {
 }
 
 @group(0) @binding(0) var<storage, read> bvh_nodes: array<BvhNode>;
-// Three vertices per triangle (xyz, w unused), in BVH order.
-@group(0) @binding(1) var<storage, read> tri_verts: array<vec4<f32>>;
+// Three rows per triangle, in BVH order: the x, the y and the z coordinates of its
+// vertices 0, 1 and 2 (w unused), so that the triangle test reads the rows of its ray's
+// Woop axes by index (igi_core::bvh::Bvh::tri_rows).
+@group(0) @binding(1) var<storage, read> tri_rows: array<vec4<f32>>;
 @group(0) @binding(2) var<storage, read> tri_shading: array<TriShading>;
 @group(0) @binding(3) var<storage, read> materials: array<Material>;
 @group(0) @binding(4) var<storage, read> lights: array<PointLight>;

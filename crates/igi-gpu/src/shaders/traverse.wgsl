@@ -1,6 +1,6 @@
 // traverse.wgsl: the ray-tracing layer of igi, which replaces OptiX in the system of
 // Marques and Santos ("Instant Global Illumination on the GPU using OptiX"): closest-hit
-// and any-hit traversal of the BVH of scene.wgsl (bvh_nodes, tri_verts), the watertight
+// and any-hit traversal of the BVH of scene.wgsl (bvh_nodes, tri_rows), the watertight
 // ray-triangle test (Woop, Benthin, Wald, JCGT 2013), the robust slab test (Ize, JCGT
 // 2013) and the ray origin offset of Wächter and Binder (Ray Tracing Gems, ch. 6).
 //
@@ -60,7 +60,8 @@ struct Hit {
 
 // Per-ray constants, computed once by make_ray.
 struct TraceRay {
-    origin: vec3<f32>,
+    // The origin in the Woop axes: (origin[kx], origin[ky], origin[kz]).
+    origin_k: vec3<f32>,
     inv_dir: vec3<f32>,
     // Woop et al. shear (dir[kx] / dir[kz], dir[ky] / dir[kz], 1 / dir[kz]).
     shear: vec3<f32>,
@@ -113,7 +114,8 @@ fn make_ray(origin: vec3<f32>, dir: vec3<f32>) -> TraceRay {
     let positive = inv_dir > vec3<f32>(0.0);
     let c_min = select(pad - oi, -(origin + slack) * inv_dir - pad, positive);
     let c_max = select(-oi - pad, -(origin - slack) * inv_dir + pad, positive);
-    return TraceRay(origin, inv_dir, shear, kx, ky, kz, c_min, c_max);
+    let origin_k = woop_axes(origin, vec3<u32>(kx, ky, kz));
+    return TraceRay(origin_k, inv_dir, shear, kx, ky, kz, c_min, c_max);
 }
 
 // Where the ray crosses a box's slabs: per axis the nearer and the farther plane's
@@ -165,28 +167,37 @@ fn box_hit(bmin: vec3<f32>, bmax: vec3<f32>, r: TraceRay, tmax: f32) -> bool {
     return span.x <= span.y;
 }
 
-// (v[kx], v[ky], v[kz]) of the ray's Woop axes, by selects. Indexing a vector with a
-// run-time index (v[r.kx]) compiled to something much slower on NVIDIA's Vulkan driver
-// (the traversal ran 14-17% slower with it on an H200, docs/PERFORMANCE.md attempt 5);
-// the values and hence the results are the same.
-fn perm(v: vec3<f32>, r: TraceRay) -> vec3<f32> {
-    let k = vec3<u32>(r.kx, r.ky, r.kz);
+// (v[k.x], v[k.y], v[k.z]), by selects: the ray's origin in its Woop axes (make_ray).
+// Indexing a vector with a run-time index (v[r.kx]) compiled to something much slower on
+// NVIDIA's Vulkan driver (the traversal ran 14-17% slower with it on an H200,
+// docs/PERFORMANCE.md attempt 5); the values are the same.
+fn woop_axes(v: vec3<f32>, k: vec3<u32>) -> vec3<f32> {
     return select(select(vec3<f32>(v.x), vec3<f32>(v.y), k == vec3<u32>(1u)), vec3<f32>(v.z), k == vec3<u32>(2u));
 }
 
 // Watertight two-sided ray-triangle test: (t, u, v) of a hit with 0 < t < tmax, else
 // t = -1. Edge and vertex hits count: a ray through a shared edge or vertex never leaks.
-fn intersect_triangle(r: TraceRay, v0: vec3<f32>, v1: vec3<f32>, v2: vec3<f32>, tmax: f32) -> vec3<f32> {
+// The triangle comes as its rows in the ray's Woop axes: xr = (v0, v1, v2)[kx], yr the
+// [ky] and zr the [kz] coordinates, read from tri_rows by index (tri_rows[3 slot + kx]),
+// so that the test permutes nothing: stored as vertices, the coordinates took 18 selects
+// a test to pick, and without them random segments ran 4% faster,
+// closest hits 11.5% and canonical frames 2.2% (docs/PERFORMANCE.md attempt 102). The
+// values are the same: (v - o)[kx] = v[kx] - o[kx].
+fn intersect_triangle(r: TraceRay, xr: vec3<f32>, yr: vec3<f32>, zr: vec3<f32>, tmax: f32) -> vec3<f32> {
     let miss = vec3<f32>(-1.0, 0.0, 0.0);
-    let a = perm(v0 - r.origin, r);
-    let b = perm(v1 - r.origin, r);
-    let c = perm(v2 - r.origin, r);
-    let ax = a.x - r.shear.x * a.z;
-    let ay = a.y - r.shear.y * a.z;
-    let bx = b.x - r.shear.x * b.z;
-    let by = b.y - r.shear.y * b.z;
-    let cx = c.x - r.shear.x * c.z;
-    let cy = c.y - r.shear.y * c.z;
+    // Per row the three vertices moved to the origin: dx = (a.x, b.x, c.x) of the
+    // translated, permuted vertices a, b, c; then sheared so that the ray runs along +z.
+    let dx = xr - vec3<f32>(r.origin_k.x);
+    let dy = yr - vec3<f32>(r.origin_k.y);
+    let dz = zr - vec3<f32>(r.origin_k.z);
+    let sx = dx - r.shear.x * dz;
+    let sy = dy - r.shear.y * dz;
+    let ax = sx.x;
+    let ay = sy.x;
+    let bx = sx.y;
+    let by = sy.y;
+    let cx = sx.z;
+    let cy = sy.z;
     // Edge functions U (weight of v0), V (v1), W (v2) as pairs of rounded products: the
     // signs come from comparing them, never from a (possibly fused) difference.
     let pu1 = cx * by;
@@ -206,9 +217,9 @@ fn intersect_triangle(r: TraceRay, v0: vec3<f32>, v1: vec3<f32>, v2: vec3<f32>, 
     if (det == 0.0) {
         return miss;
     }
-    let az = r.shear.z * a.z;
-    let bz = r.shear.z * b.z;
-    let cz = r.shear.z * c.z;
+    let az = r.shear.z * dz.x;
+    let bz = r.shear.z * dz.y;
+    let cz = r.shear.z * dz.z;
     let tt = eu * az + ev * bz + ew * cz;
     let rcp = 1.0 / det;
     let t = tt * rcp;
@@ -223,7 +234,7 @@ fn leaf_closest(first: u32, count: u32, r: TraceRay, hit_in: Hit) -> Hit {
     var hit = hit_in;
     for (var slot = first; slot < first + count; slot++) {
         let i = 3u * slot;
-        let h = intersect_triangle(r, tri_verts[i].xyz, tri_verts[i + 1u].xyz, tri_verts[i + 2u].xyz, hit.t);
+        let h = intersect_triangle(r, tri_rows[i + r.kx].xyz, tri_rows[i + r.ky].xyz, tri_rows[i + r.kz].xyz, hit.t);
         if (h.x > 0.0) {
             hit = Hit(h.x, slot, h.y, h.z);
         }
@@ -234,13 +245,18 @@ fn leaf_closest(first: u32, count: u32, r: TraceRay, hit_in: Hit) -> Hit {
 fn leaf_any(first: u32, count: u32, r: TraceRay, tmax: f32, boxes: bool) -> bool {
     for (var slot = first; slot < first + count; slot++) {
         let i = 3u * slot;
-        let v0 = tri_verts[i].xyz;
-        let v1 = tri_verts[i + 1u].xyz;
-        let v2 = tri_verts[i + 2u].xyz;
-        if (boxes && box_crossed(min(v0, min(v1, v2)), max(v0, max(v1, v2)), r, tmax)) {
-            return true;
+        if (boxes) {
+            // The triangle's box: per axis the extremes of that axis's row.
+            let x = tri_rows[i].xyz;
+            let y = tri_rows[i + 1u].xyz;
+            let z = tri_rows[i + 2u].xyz;
+            let lo = vec3<f32>(min(x.x, min(x.y, x.z)), min(y.x, min(y.y, y.z)), min(z.x, min(z.y, z.z)));
+            let hi = vec3<f32>(max(x.x, max(x.y, x.z)), max(y.x, max(y.y, y.z)), max(z.x, max(z.y, z.z)));
+            if (box_crossed(lo, hi, r, tmax)) {
+                return true;
+            }
         }
-        let h = intersect_triangle(r, v0, v1, v2, tmax);
+        let h = intersect_triangle(r, tri_rows[i + r.kx].xyz, tri_rows[i + r.ky].xyz, tri_rows[i + r.kz].xyz, tmax);
         if (h.x > 0.0) {
             return true;
         }
