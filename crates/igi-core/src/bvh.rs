@@ -224,6 +224,12 @@ pub struct BuildStats {
     pub sah_cost: f32,
 }
 
+/// Vertices 0, 1 and 2 of BVH slot `slot` of [`Bvh::tri_rows`].
+fn rows_to_vertices(tri_rows: &[[f32; 4]], slot: usize) -> [Vec3; 3] {
+    let [x, y, z] = [0, 1, 2].map(|axis| tri_rows[3 * slot + axis]);
+    [0, 1, 2].map(|j| Vec3::new(x[j], y[j], z[j]))
+}
+
 /// A BVH over triangles, in the layout the GPU reads (`scene.wgsl`, bind group 0).
 #[derive(Clone, Debug)]
 pub struct Bvh {
@@ -279,9 +285,7 @@ impl Bvh {
 
     /// Vertices of the triangle in BVH slot `slot`.
     pub fn triangle(&self, slot: u32) -> [Vec3; 3] {
-        let i = 3 * slot as usize;
-        let (x, y, z) = (self.tri_rows[i], self.tri_rows[i + 1], self.tri_rows[i + 2]);
-        [0, 1, 2].map(|j| Vec3::new(x[j], y[j], z[j]))
+        rows_to_vertices(&self.tri_rows, slot as usize)
     }
 
     /// Box of the whole scene (min, max); inverted-infinite for no triangles.

@@ -629,9 +629,8 @@ fn occluder_first(nodes: &mut [BvhNode], tri_rows: &[[f32; 4]]) {
     let mut slot_area = vec![0.0f32; tri_rows.len() / 3];
     par_chunks(&mut slot_area, 1, |base, chunk| {
         for (k, out) in chunk.iter_mut().enumerate() {
-            let rows = &tri_rows[3 * (base + k)..3 * (base + k) + 3];
-            let v = |j: usize| Vec3A::new(rows[0][j], rows[1][j], rows[2][j]);
-            let a = 0.5 * (v(1) - v(0)).cross(v(2) - v(0)).length();
+            let [v0, v1, v2] = super::rows_to_vertices(tri_rows, base + k).map(Vec3A::from);
+            let a = 0.5 * (v1 - v0).cross(v2 - v0).length();
             *out = if a.is_finite() { a } else { 0.0 };
         }
     });

@@ -178,7 +178,7 @@ fn woop_axes(v: vec3<f32>, k: vec3<u32>) -> vec3<f32> {
 // Watertight two-sided ray-triangle test: (t, u, v) of a hit with 0 < t < tmax, else
 // t = -1. Edge and vertex hits count: a ray through a shared edge or vertex never leaks.
 // The triangle comes as its rows in the ray's Woop axes: xr = (v0, v1, v2)[kx], yr the
-// [ky] and zr the [kz] coordinates, read from tri_rows by index (tri_rows[3 slot + kx]),
+// [ky] and zr the [kz] coordinates, read from tri_rows by index (slot_rows),
 // so that the test permutes nothing: stored as vertices, the coordinates took 18 selects
 // a test to pick, and without them random segments ran 4% faster,
 // closest hits 11.5% and canonical frames 2.2% (docs/PERFORMANCE.md attempt 102). The
@@ -229,12 +229,25 @@ fn intersect_triangle(r: TraceRay, xr: vec3<f32>, yr: vec3<f32>, zr: vec3<f32>, 
     return miss;
 }
 
+// The rows of BVH slot `slot` in the ray's Woop axes (the test's xr, yr, zr), read by
+// index: the twin of igi_core's slot_rows.
+struct WoopRows {
+    x: vec3<f32>,
+    y: vec3<f32>,
+    z: vec3<f32>,
+}
+
+fn slot_rows(slot: u32, r: TraceRay) -> WoopRows {
+    let i = 3u * slot;
+    return WoopRows(tri_rows[i + r.kx].xyz, tri_rows[i + r.ky].xyz, tri_rows[i + r.kz].xyz);
+}
+
 // The triangles of a leaf in slot order; equal distances keep the first hit.
 fn leaf_closest(first: u32, count: u32, r: TraceRay, hit_in: Hit) -> Hit {
     var hit = hit_in;
     for (var slot = first; slot < first + count; slot++) {
-        let i = 3u * slot;
-        let h = intersect_triangle(r, tri_rows[i + r.kx].xyz, tri_rows[i + r.ky].xyz, tri_rows[i + r.kz].xyz, hit.t);
+        let rows = slot_rows(slot, r);
+        let h = intersect_triangle(r, rows.x, rows.y, rows.z, hit.t);
         if (h.x > 0.0) {
             hit = Hit(h.x, slot, h.y, h.z);
         }
@@ -256,7 +269,8 @@ fn leaf_any(first: u32, count: u32, r: TraceRay, tmax: f32, boxes: bool) -> bool
                 return true;
             }
         }
-        let h = intersect_triangle(r, tri_rows[i + r.kx].xyz, tri_rows[i + r.ky].xyz, tri_rows[i + r.kz].xyz, tmax);
+        let rows = slot_rows(slot, r);
+        let h = intersect_triangle(r, rows.x, rows.y, rows.z, tmax);
         if (h.x > 0.0) {
             return true;
         }
