@@ -225,8 +225,11 @@ pub struct BuildStats {
 }
 
 /// Vertices 0, 1 and 2 of BVH slot `slot` of [`Bvh::tri_rows`].
+#[inline]
 fn rows_to_vertices(tri_rows: &[[f32; 4]], slot: usize) -> [Vec3; 3] {
-    let [x, y, z] = [0, 1, 2].map(|axis| tri_rows[3 * slot + axis]);
+    let [x, y, z] = &tri_rows[3 * slot..3 * slot + 3] else {
+        unreachable!("a slot has three rows")
+    };
     [0, 1, 2].map(|j| Vec3::new(x[j], y[j], z[j]))
 }
 
