@@ -131,7 +131,7 @@ fn main() {
     for p in &hit_points {
         for l in &scene.lights {
             let o = *p + (cam.eye - *p).normalize() * 1e-3;
-            occluded += usize::from(bvh.trace_any(o, l.position - o, 1.0));
+            occluded += usize::from(bvh.trace_segment(o, l.position - o));
             rays += 1;
         }
     }

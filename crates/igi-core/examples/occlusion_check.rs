@@ -65,7 +65,7 @@ struct Tally {
 
 impl Tally {
     fn add(&mut self, bvh: &Bvh, tris: &[[Vec3; 3]], (o, d): (Vec3, Vec3)) {
-        let f32_answer = bvh.trace_any(o, d, 1.0);
+        let f32_answer = bvh.trace_segment(o, d);
         let exact = tris.iter().any(|t| crosses(v64(o), v64(d), t));
         self.segments += 1;
         self.occluded += u32::from(exact);

@@ -312,4 +312,12 @@ impl Bvh {
     pub fn trace_any(&self, origin: Vec3, dir: Vec3, tmax: f32) -> bool {
         traverse::trace_any(self, origin, dir, tmax)
     }
+
+    /// Whether the segment from `origin` to `origin + dir` is occluded (a hit with 0 < t <
+    /// 1), by the walk that the renderer's shadow rays take on the GPU (see
+    /// `shadow_segment`): the answer of `trace_any(origin, dir, 1.0)` but for hits that
+    /// rounding alone decides within a few ulps of either end.
+    pub fn trace_segment(&self, origin: Vec3, dir: Vec3) -> bool {
+        traverse::trace_segment(self, origin, dir)
+    }
 }

@@ -35,7 +35,7 @@ fn irradiance(
     for l in &scene.lights {
         let d = l.position - p;
         let cos = ns.dot(d) / d.length();
-        if cos > 0.0 && ng.dot(d) > 0.0 && !bvh.trace_any(origin, l.position - origin, 1.0) {
+        if cos > 0.0 && ng.dot(d) > 0.0 && !bvh.trace_segment(origin, l.position - origin) {
             e += l.intensity * cos / d.length_squared();
         }
     }
@@ -52,7 +52,7 @@ fn irradiance(
             let t = ((dist - 0.8 * m) / (0.4 * m)).clamp(0.0, 1.0);
             let g = cx * cy * t * t * (3.0 - 2.0 * t) / dist2;
             let end = offset_ray_origin(y, ny, floor);
-            if g > 0.0 && !bvh.trace_any(origin, end - origin, 1.0) {
+            if g > 0.0 && !bvh.trace_segment(origin, end - origin) {
                 e += Vec3::from(v.flux) * Vec3::from(v.albedo) * (g / PI);
             }
         }

@@ -1,7 +1,9 @@
 //! The GPU ray-tracing layer (traverse.wgsl, igi's replacement for OptiX in Marques and
 //! Santos' IGI) against the CPU, ray by ray: the brute-force reference (same triangle,
 //! same distance within 1e-5 relative, same occlusion answer) and the CPU BVH traversal,
-//! its twin (same answers; bit-identical where the GPU rounds like the CPU).
+//! its twin (same answers; bit-identical where the GPU rounds like the CPU). Every ray is
+//! also traced as a segment (trace_segment: from the origin to origin + dir), the walk of
+//! the renderer's shadow rays.
 //!
 //! Runs on the adapter `GpuContext` picks (lavapipe where there is no GPU:
 //! `apt-get install mesa-vulkan-drivers`; set XDG_RUNTIME_DIR=/tmp to silence its
@@ -20,7 +22,8 @@ use wgpu::util::DeviceExt;
 const SCENE: &str = include_str!("../src/shaders/scene.wgsl");
 const TRAVERSE: &str = include_str!("../src/shaders/traverse.wgsl");
 
-/// Traces each ray for closest and any hit, and offsets its origin along its normal.
+/// Traces each ray for closest and any hit and as a segment, and offsets its origin along
+/// its normal.
 const KERNEL: &str = r#"
 struct TestRay {
     origin: vec3<f32>, tmax: f32,
@@ -30,7 +33,7 @@ struct TestRay {
 
 struct TestResult {
     hit: Hit,
-    any_hit: u32, _p0: u32, _p1: u32, _p2: u32,
+    any_hit: u32, segment: u32, _p1: u32, _p2: u32,
     offset: vec3<f32>, _p3: f32,
 }
 
@@ -48,6 +51,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     var stack: WalkStack;
     res.hit = trace_closest(&stack, r.origin, r.dir, r.tmax);
     res.any_hit = select(0u, 1u, trace_any(&stack, r.origin, r.dir, r.tmax));
+    res.segment = select(0u, 1u, trace_segment(&stack, r.origin, r.dir, false));
     res.offset = offset_ray_origin(r.origin, r.normal, r.floor);
     results[i] = res;
 }
@@ -66,13 +70,15 @@ struct TestRay {
     floor: f32,
 }
 
-/// `TestResult` of the kernel: 48 bytes (hit 0..16, any_hit 16..20, offset 32..44).
+/// `TestResult` of the kernel: 48 bytes (hit 0..16, any_hit 16..20, segment 20..24,
+/// offset 32..44).
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable, Debug)]
 struct TestResult {
     hit: Hit,
     any_hit: u32,
-    _p: [u32; 3],
+    segment: u32,
+    _p: [u32; 2],
     offset: [f32; 3],
     _p3: f32,
 }
@@ -265,6 +271,13 @@ fn check_builder(ctx: &GpuContext, builder: BvhBuilder) {
                 res.any_hit
             ));
         }
+        let bf_segment = brute_force_any(&tris, o, d, 1.0);
+        if (res.segment == 1) != bf_segment {
+            fail(format!(
+                "segment: GPU {}, brute force {bf_segment}",
+                res.segment
+            ));
+        }
         let on_fan = g_tri.is_some_and(|t| fan.contains(&(t as usize)));
         if matches!(kind, Kind::FanVertex | Kind::FanSpoke) && (res.any_hit != 1 || !on_fan) {
             fail(format!("leaked through the fan (GPU tri {g_tri:?})"));
@@ -291,6 +304,9 @@ fn check_builder(ctx: &GpuContext, builder: BvhBuilder) {
         }
         if bvh.trace_any(o, d, ray.tmax) != (res.any_hit == 1) {
             fail("any hit differs from the CPU BVH".to_string());
+        }
+        if bvh.trace_segment(o, d) != (res.segment == 1) {
+            fail("segment differs from the CPU BVH".to_string());
         }
 
         // The ray offset: bit for bit.

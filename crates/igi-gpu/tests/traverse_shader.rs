@@ -19,7 +19,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let o = vec3<f32>(f32(gid.x), 0.5, -3.0);
     var stack: WalkStack;
     let h = trace_closest(&stack, o, vec3<f32>(0.0, 0.0, 1.0), 1e30);
-    let a = trace_any(&stack, o, vec3<f32>(0.0, 1.0, 0.0), 1.0);
+    let a = trace_any(&stack, o, vec3<f32>(0.0, 1.0, 0.0), 1.0) || trace_segment(&stack, o, vec3<f32>(1.0, 0.0, 0.0), true);
     let p = offset_ray_origin(o, vec3<f32>(0.0, 1.0, 0.0), 0.0);
     let s = shadow_segment(o, vec3<f32>(0.0, 1.0, 0.0), p, vec3<f32>(1.0, 0.0, 0.0), 0.25);
     out[gid.x] = vec4<f32>(h.t + f32(h.tri) + h.u + h.v, select(0.0, 1.0, a), p.x + s.origin.y, s.dir.z);
@@ -76,6 +76,7 @@ fn constants_match_the_cpu_twin() {
     assert_eq!(f("PARALLEL_INV"), 1e30);
     assert_eq!(f("PARALLEL_SLACK"), 1.0 / 1_048_576.0);
     assert_eq!(f("SLAB_PAD"), 1.0 / 2_097_152.0);
+    assert_eq!(f("SEGMENT_PAD"), 1.0 / 2_097_152.0);
     assert_eq!(f("OFFSET_ORIGIN"), 1.0 / 32.0);
     assert_eq!(f("OFFSET_FLOAT_SCALE"), 1.0 / 65536.0);
     assert_eq!(f("OFFSET_INT_SCALE"), 256.0);

@@ -210,6 +210,13 @@ fn check_ray(bvh: &Bvh, tris: &[[Vec3; 3]], o: Vec3, d: Vec3, tmax: f32) -> usiz
         "any-hit of ray {o} {d} tmax {tmax}"
     );
     assert_eq!(bf.is_some(), bvh.trace_any(o, d, tmax));
+    if tmax == 1.0 {
+        assert_eq!(
+            bf.is_some(),
+            bvh.trace_segment(o, d),
+            "segment walk of {o} {d}"
+        );
+    }
     usize::from(bf.is_some())
 }
 
@@ -725,7 +732,7 @@ fn segments_ending_on_a_huge_floor_are_not_occluded_by_it() {
         for (a, na, b, nb) in [(a, na, b, nb), (b, nb, a, na)] {
             let (o, d) = shadow_segment(a, na, b, nb, offset);
             assert!(
-                !brute_force_any(&floor, o, d, 1.0) && !floor_bvh.trace_any(o, d, 1.0),
+                !brute_force_any(&floor, o, d, 1.0) && !floor_bvh.trace_segment(o, d),
                 "segment {a} -> {b} occluded by the floor it ends on"
             );
         }
@@ -739,7 +746,7 @@ fn segments_ending_on_a_huge_floor_are_not_occluded_by_it() {
         for (a, na, b, nb) in [(x, up, h, -up), (h, -up, x, up)] {
             let (o, d) = shadow_segment(a, na, b, nb, offset);
             assert!(
-                bvh.trace_any(o, d, 1.0),
+                bvh.trace_segment(o, d),
                 "segment {a} -> {b} missed the plate at {c}"
             );
         }
@@ -806,18 +813,18 @@ fn segments_between_facing_planes_are_unoccluded() {
                 let y = point_on(&mut r, t2);
                 let (o, d) = shadow_segment(x, normal(t1), y, normal(t2), offset);
                 assert!(
-                    !bvh.trace_any(o, d, 1.0),
+                    !bvh.trace_segment(o, d),
                     "segment {x} -> {y} occluded (gap {gap}, size {size})"
                 );
                 let (o, d) = shadow_segment(y, normal(t2), x, normal(t1), offset);
-                assert!(!bvh.trace_any(o, d, 1.0), "segment {y} -> {x} occluded");
+                assert!(!bvh.trace_segment(o, d), "segment {y} -> {x} occluded");
                 // A segment that goes on beyond the far plane must be occluded by it.
                 // Aimed at the inner half of the far quad: the offset of x shifts where a
                 // grazing segment crosses it by up to offset * length / gap.
                 let yc = c + gap * n + 0.5 * (y - c - gap * n);
                 let (o, d) = shadow_segment(x, normal(t1), yc + (yc - x), normal(t2), offset);
                 assert!(
-                    bvh.trace_any(o, d, 1.0),
+                    bvh.trace_segment(o, d),
                     "segment {x} -> {} through the far plane missed it (gap {gap}, size {size})",
                     yc + (yc - x)
                 );
@@ -996,7 +1003,7 @@ fn split_build_tests_fewer_triangles_on_slivers() {
         for _ in 0..5000 {
             let o = rand_vec(r, -10.0, 10.0);
             let d = rand_vec(r, -10.0, 10.0) - o;
-            let (_, n, t) = traverse::trace_any_counted(bvh, o, d, 1.0);
+            let (_, n, t) = traverse::trace_segment_counted(bvh, o, d);
             (nodes, tests) = (nodes + n as u64, tests + t as u64);
         }
         (nodes, tests)
@@ -1053,4 +1060,179 @@ fn rays_through_tile_corners_far_from_the_origin_hit() {
             check_ray(&bvh, &tris, o, d, 2.0);
         }
     }
+}
+
+/// Whether the ray meets the box at some t in (0, tmax], in f64 on the f32 data (the
+/// differences b - o are exact in f64; only the division rounds, at 2^-53), by a margin of
+/// 1e-12 relative: the boxes a conservative slab test must hit. No parallel axes.
+fn box_met_exactly(min: [f32; 3], max: [f32; 3], o: Vec3, d: Vec3, tmax: f32) -> bool {
+    let (mut near, mut far) = (0.0f64, tmax as f64);
+    for k in 0..3 {
+        let t0 = (min[k] as f64 - o[k] as f64) / d[k] as f64;
+        let t1 = (max[k] as f64 - o[k] as f64) / d[k] as f64;
+        near = near.max(t0.min(t1));
+        far = far.min(t0.max(t1));
+    }
+    far > 0.0 && near <= far - 1e-12 * near.abs().max(far.abs())
+}
+
+/// Random rays (no parallel axes) with boxes around points of them: random ones, and
+/// boxes the ray only grazes, entering one slab where it leaves another at a point of
+/// the ray (a corner or an edge of the box on the ray), near t = 1 half the time.
+fn grazing_boxes(r: &mut Pcg64, n: usize) -> Vec<(Vec3, Vec3, [f32; 3], [f32; 3])> {
+    let mut out = vec![];
+    while out.len() < n {
+        let scale = [1e-2f32, 1.0, 100.0, 1e4][r.random_range(0..4)];
+        let o = rand_vec(r, -1.0, 1.0) * scale;
+        let d = rand_dir(r) * scale * r.random_range(0.1..3.0);
+        if d.abs().min_element() < 1e-3 * d.abs().max_element() {
+            continue;
+        }
+        let t = if r.random_bool(0.5) {
+            r.random_range(0.98..1.02)
+        } else {
+            r.random_range(0.0..1.5)
+        };
+        let p = o + t * d;
+        let ext = |r: &mut Pcg64| r.random_range(0.0..0.5) * d.abs().max_element();
+        let (mut lo, mut hi) = ([0.0f32; 3], [0.0f32; 3]);
+        for k in 0..3 {
+            (lo[k], hi[k]) = (p[k] - ext(r), p[k] + ext(r));
+        }
+        if r.random_bool(0.8) {
+            // Enter axis a and leave axis b at p.
+            let a = r.random_range(0..3);
+            let b = (a + r.random_range(1..3)) % 3;
+            if d[a] > 0.0 {
+                lo[a] = p[a];
+            } else {
+                hi[a] = p[a];
+            }
+            if d[b] > 0.0 {
+                hi[b] = p[b];
+            } else {
+                lo[b] = p[b];
+            }
+        }
+        out.push((o, d, lo, hi));
+    }
+    out
+}
+
+#[test]
+fn slab_tests_hit_every_box_the_exact_ray_meets() {
+    // The conservative slab test (SLAB_PAD, BOX_TFAR_SCALE) and the segment walk's
+    // (SEGMENT_PAD in place of the scale) on boxes a ray grazes within 1e-12: neither may
+    // miss one. Without the pad and the scale the same boxes are missed by rounding.
+    use traverse::{box_hit, TraceRay, BOX_TFAR_SCALE, SEGMENT_PAD};
+    let mut r = rng(104);
+    let cases = grazing_boxes(&mut r, 200_000);
+    let (mut met, mut missed_unpadded) = (0, 0);
+    for &(o, d, lo, hi) in &cases {
+        let tmax = if r.random_bool(0.5) {
+            1.0
+        } else {
+            r.random_range(0.5..2.0)
+        };
+        if !box_met_exactly(lo, hi, o, d, tmax) {
+            continue;
+        }
+        met += 1;
+        let ray = TraceRay::new(o, d, 0.0).unwrap();
+        assert!(
+            box_hit(lo, hi, &ray, tmax, BOX_TFAR_SCALE),
+            "scaled walk missed {lo:?} {hi:?} from {o} along {d}, tmax {tmax}"
+        );
+        missed_unpadded += usize::from(!box_hit(lo, hi, &ray, tmax, 1.0));
+        if tmax == 1.0 {
+            let segment = TraceRay::new(o, d, SEGMENT_PAD).unwrap();
+            assert!(
+                box_hit(lo, hi, &segment, 1.0, 1.0),
+                "segment walk missed {lo:?} {hi:?} from {o} along {d}"
+            );
+        }
+    }
+    println!(
+        "{met} boxes met of {}; without the scale, {missed_unpadded} missed",
+        cases.len()
+    );
+    assert!(met > cases.len() / 4, "too few boxes met ({met})");
+    assert!(
+        missed_unpadded > 0,
+        "the cases do not graze: the test could not fail"
+    );
+}
+
+#[test]
+fn slab_minima_on_bits_agree_with_floats() {
+    // box_span takes its minima and maxima on the distances' bits; where that can differ
+    // from floats (negative distances, -0) the box must still be hit wherever floats hit
+    // it at some t > 0, and with the floats' entry and exit.
+    use traverse::{box_span, TraceRay, BOX_TFAR_SCALE};
+    let float_span = |lo: [f32; 3], hi: [f32; 3], o: Vec3, d: Vec3, tmax: f32| {
+        let ray = TraceRay::new(o, d, 0.0).unwrap();
+        let (t0, t1) = ray.plane_distances(lo, hi);
+        let (tn, tf) = (t0.min(t1), t0.max(t1));
+        let near = tn.x.max(tn.y).max(tn.z.max(0.0));
+        let far = (tf.x.min(tf.y).min(tf.z) * BOX_TFAR_SCALE).min(tmax);
+        (near, far)
+    };
+    let mut r = rng(105);
+    let mut cases = grazing_boxes(&mut r, 100_000);
+    // Origins and planes on zero coordinates (distances of +-0), and axis-parallel rays.
+    for _ in 0..100_000 {
+        let o =
+            rand_vec(&mut r, -2.0, 2.0)
+                .to_array()
+                .map(|c| if r.random_bool(0.4) { 0.0 } else { c });
+        let mut d = rand_dir(&mut r);
+        for k in 0..3 {
+            if r.random_bool(0.2) {
+                d[k] = [0.0, -0.0, 1e-31][r.random_range(0..3)];
+            }
+        }
+        let c = |r: &mut Pcg64| {
+            if r.random_bool(0.4) {
+                0.0
+            } else {
+                r.random_range(-2.0..2.0f32)
+            }
+        };
+        let (a, b) = (
+            [c(&mut r), c(&mut r), c(&mut r)],
+            [c(&mut r), c(&mut r), c(&mut r)],
+        );
+        let lo = std::array::from_fn(|k| a[k].min(b[k]));
+        let hi = std::array::from_fn(|k| a[k].max(b[k]));
+        cases.push((Vec3::from(o), d, lo, hi));
+    }
+    let (mut hits, mut zeros) = (0, 0);
+    for &(o, d, lo, hi) in &cases {
+        if d == Vec3::ZERO {
+            continue;
+        }
+        let tmax = r.random_range(0.5..2.0);
+        let (fnear, ffar) = float_span(lo, hi, o, d, tmax);
+        let (near, far) = box_span(
+            lo,
+            hi,
+            &TraceRay::new(o, d, 0.0).unwrap(),
+            tmax,
+            BOX_TFAR_SCALE,
+        );
+        if fnear <= ffar && ffar > 0.0 {
+            hits += 1;
+            assert!(
+                near <= far && near == fnear && far == ffar,
+                "bits ({near}, {far}), floats ({fnear}, {ffar}): {lo:?} {hi:?} from {o} along {d}"
+            );
+        } else if fnear <= ffar {
+            zeros += 1;
+        }
+    }
+    println!(
+        "{hits} boxes hit of {}, {zeros} at t = 0 alone",
+        cases.len()
+    );
+    assert!(hits > cases.len() / 4, "too few hits ({hits})");
 }

@@ -75,6 +75,24 @@ pub(crate) const SLAB_PAD: f32 = 1.0 / 2_097_152.0;
 /// for division, which would need 1 + 2 gamma(7) to be strictly covered.
 pub(crate) const BOX_TFAR_SCALE: f32 = 1.0 + 3.0 * f32::EPSILON;
 
+/// Absolute pad of every plane of a segment walk ([`trace_segment`], tmax = 1): 2^-21, in
+/// place of [`BOX_TFAR_SCALE`].
+///
+/// The scale covers the slab distances' relative errors, at most gamma(3) |t| on either
+/// end (see [`BOX_TFAR_SCALE`]), for rays of any length; it costs a product per box. A
+/// segment only asks about t in [0, 1], where those errors are at most gamma(3) < 2^-22.4:
+/// moving every entry plane down and every exit plane up by 2^-21 in t (added to
+/// [`SLAB_PAD`]'s per-ray offsets, so free per box) covers them. Where the exact slab meets
+/// [0, 1] (entry e <= 1 and e <= exit x), the computed entry is at most e (for e <= 1 the
+/// pad exceeds its error), and the computed exit at least min(x, 1) (for x <= 2.6 the pad
+/// exceeds its error; beyond, the computed exit is still above 1): the box is hit. So a
+/// segment walk visits every box the exact test would, as the scaled walk does, and both
+/// answer what the triangle tests answer. It does not hold for long rays (a ray of tmax
+/// 3.4e38 would need a pad that opens every box), which keep the scale ([`trace_any`]).
+/// The renderer's shadow rays are all segments (`shadow_segment`); their walk ran 1.5%
+/// faster on the H200 (docs/PERFORMANCE.md attempt 104).
+pub(crate) const SEGMENT_PAD: f32 = 1.0 / 2_097_152.0;
+
 /// Wächter-Binder offset: distance below which coordinates get an absolute offset.
 const OFFSET_ORIGIN: f32 = 1.0 / 32.0;
 /// Wächter-Binder offset: absolute offset (times the normal) near the origin.
@@ -118,8 +136,9 @@ pub(crate) struct TraceRay {
 }
 
 impl TraceRay {
-    /// None for a zero direction (such a ray hits nothing).
-    pub(crate) fn new(origin: Vec3, dir: Vec3) -> Option<TraceRay> {
+    /// None for a zero direction (such a ray hits nothing). `t_pad` moves every plane
+    /// outward by that much in t: [`SEGMENT_PAD`] for segment walks, else 0.
+    pub(crate) fn new(origin: Vec3, dir: Vec3, t_pad: f32) -> Option<TraceRay> {
         if dir.x == 0.0 && dir.y == 0.0 && dir.z == 0.0 {
             return None;
         }
@@ -159,7 +178,7 @@ impl TraceRay {
             if parallel[k] {
                 0.0
             } else {
-                oi[k].abs() * SLAB_PAD
+                oi[k].abs() * SLAB_PAD + t_pad
             }
         }));
         // The min corner's planes are the entry planes where inv_dir > 0 (parallel axes
@@ -178,6 +197,16 @@ impl TraceRay {
             shear,
         })
     }
+
+    /// The distances to the planes of a box's min corner and of its max corner: one fused
+    /// multiply-add each with the padded offsets (see [`box_span`] and [`SLAB_PAD`]).
+    #[inline]
+    pub(crate) fn plane_distances(&self, min: [f32; 3], max: [f32; 3]) -> (Vec3, Vec3) {
+        (
+            Vec3::from(min).mul_add(self.inv_dir, self.c_min),
+            Vec3::from(max).mul_add(self.inv_dir, self.c_max),
+        )
+    }
 }
 
 /// Slab test: the (entry, exit) distances of a box clipped to [0, tmax]; the box is hit
@@ -189,21 +218,45 @@ impl TraceRay {
 /// one, and the walks' tmax is finite ([`finite_tmax`]). Each plane's distance is one
 /// fused multiply-add with the ray's padded offsets (see [`SLAB_PAD`]). Parallel axes
 /// need no case of their own: their offsets hold the moved origins (see [`DIR_EPS`]).
+/// The far end is scaled by `far_scale`: [`BOX_TFAR_SCALE`], or 1 for a segment walk,
+/// whose planes are padded instead ([`SEGMENT_PAD`]).
+///
+/// The minima and maxima are taken on the distances' bits read as signed integers (the
+/// GPU's integer minimum and maximum made the walks 1-6% faster on the H200 than float
+/// ones, docs/PERFORMANCE.md attempt 104). Non-negative floats order like their bits;
+/// negative ones come below all of them, in reverse order among themselves, and -0 is
+/// the lowest of all. The reverse order never changes an answer: an axis whose two
+/// distances are both negative gives the entry a negative candidate, which the clamp to
+/// 0 discards whichever it is, and the exit a negative one, which misses the box (the
+/// entry is >= 0) whichever it is. -0 is the one exception: an exit of -0 (the ray leaves
+/// a slab at its origin) is picked over a negative one on another axis, so the box is
+/// kept where floats miss it (at worst a visit more), and a negative plane is picked over
+/// -0 as a slab's farther one, so the box is missed where floats keep it for t = 0 alone
+/// (no hit with t > 0 lies in it: every plane is padded outward). Wherever the box is
+/// hit, the entry and the exit are the floats'.
 #[inline]
-fn box_span(min: [f32; 3], max: [f32; 3], r: &TraceRay, tmax: f32) -> (f32, f32) {
-    let t0 = Vec3::from(min).mul_add(r.inv_dir, r.c_min);
-    let t1 = Vec3::from(max).mul_add(r.inv_dir, r.c_max);
-    let tn = t0.min(t1);
-    let tf = t0.max(t1);
-    let near = tn.x.max(tn.y).max(tn.z.max(0.0));
-    let far = (tf.x.min(tf.y).min(tf.z) * BOX_TFAR_SCALE).min(tmax);
-    (near, far)
+pub(super) fn box_span(
+    min: [f32; 3],
+    max: [f32; 3],
+    r: &TraceRay,
+    tmax: f32,
+    far_scale: f32,
+) -> (f32, f32) {
+    let bits = |v: Vec3| v.to_array().map(|t| t.to_bits() as i32);
+    let (t0, t1) = r.plane_distances(min, max);
+    let (t0, t1) = (bits(t0), bits(t1));
+    let tn: [i32; 3] = std::array::from_fn(|k| t0[k].min(t1[k]));
+    let tf: [i32; 3] = std::array::from_fn(|k| t0[k].max(t1[k]));
+    let near = tn[0].max(tn[1]).max(tn[2].max(0));
+    let far = tf[0].min(tf[1]).min(tf[2]);
+    let float = |b: i32| f32::from_bits(b as u32);
+    (float(near), (float(far) * far_scale).min(tmax))
 }
 
 /// The entry distance (>= 0) of a box hit within [0, tmax], -1 otherwise.
 #[inline]
 fn box_near(min: [f32; 3], max: [f32; 3], r: &TraceRay, tmax: f32) -> f32 {
-    let (near, far) = box_span(min, max, r, tmax);
+    let (near, far) = box_span(min, max, r, tmax, BOX_TFAR_SCALE);
     if near <= far {
         near
     } else {
@@ -213,8 +266,14 @@ fn box_near(min: [f32; 3], max: [f32; 3], r: &TraceRay, tmax: f32) -> f32 {
 
 /// Whether a box is hit within [0, tmax] (any hit needs no distance).
 #[inline]
-fn box_hit(min: [f32; 3], max: [f32; 3], r: &TraceRay, tmax: f32) -> bool {
-    let (near, far) = box_span(min, max, r, tmax);
+pub(super) fn box_hit(
+    min: [f32; 3],
+    max: [f32; 3],
+    r: &TraceRay,
+    tmax: f32,
+    far_scale: f32,
+) -> bool {
+    let (near, far) = box_span(min, max, r, tmax, far_scale);
     near <= far
 }
 
@@ -356,7 +415,7 @@ fn ordered(node: &super::BvhNode, r: &TraceRay, tmax: f32) -> [(f32, u32, u32); 
 /// box is hit, interior ones are descended into (the nearer) or pushed (the farther).
 /// Boxes are tested against the current closest t, so hits found prune the rest.
 pub(crate) fn trace_closest(bvh: &Bvh, origin: Vec3, dir: Vec3, tmax: f32) -> Option<Hit> {
-    let r = TraceRay::new(origin, dir)?;
+    let r = TraceRay::new(origin, dir, 0.0)?;
     let mut hit = Hit {
         t: finite_tmax(tmax),
         tri: NO_HIT,
@@ -404,9 +463,21 @@ pub(crate) fn trace_closest(bvh: &Bvh, origin: Vec3, dir: Vec3, tmax: f32) -> Op
 /// then b: the nearer-first order made the GPU's frames 4-7% slower, docs/PERFORMANCE.md
 /// attempt 31; the builder makes a the likelier occluder per unit of work, attempts 80
 /// and 84),
-/// returning at the first triangle hit with 0 < t < tmax.
+/// returning at the first triangle hit with 0 < t < tmax. For rays of any length: the
+/// far ends are scaled by [`BOX_TFAR_SCALE`].
 pub(crate) fn trace_any(bvh: &Bvh, origin: Vec3, dir: Vec3, tmax: f32) -> bool {
-    walk_any(bvh, origin, dir, tmax, &mut ())
+    walk_any(bvh, origin, dir, tmax, 0.0, BOX_TFAR_SCALE, &mut ())
+}
+
+/// Whether the segment from origin to origin + dir is occluded (a triangle hit with 0 < t
+/// < 1): the walk of [`trace_any`] with the planes padded by [`SEGMENT_PAD`] instead of
+/// the far ends scaled (`trace_segment` of traverse.wgsl, which every shadow ray of the
+/// renderer takes). Both walks visit every box the exact segment crosses, so they answer
+/// alike (and as a test of every triangle would) except for a triangle test whose
+/// rounding alone decides a hit within a few ulps of t = 0 or 1 in a box that only one
+/// of them visits.
+pub(crate) fn trace_segment(bvh: &Bvh, origin: Vec3, dir: Vec3) -> bool {
+    walk_any(bvh, origin, dir, 1.0, SEGMENT_PAD, 1.0, &mut ())
 }
 
 /// What an any-hit walk did (tests and measurements count steps with it; `()` counts
@@ -434,18 +505,28 @@ impl WalkCounter for (u32, u32) {
     }
 }
 
-/// [`trace_any`] counting its steps: (answer, nodes visited, triangles tested).
+/// [`trace_segment`] counting its steps: (answer, nodes visited, triangles tested).
 #[cfg(test)]
-pub(crate) fn trace_any_counted(bvh: &Bvh, origin: Vec3, dir: Vec3, tmax: f32) -> (bool, u32, u32) {
+pub(crate) fn trace_segment_counted(bvh: &Bvh, origin: Vec3, dir: Vec3) -> (bool, u32, u32) {
     let mut steps = (0u32, 0u32);
-    let hit = walk_any(bvh, origin, dir, tmax, &mut steps);
+    let hit = walk_any(bvh, origin, dir, 1.0, SEGMENT_PAD, 1.0, &mut steps);
     (hit, steps.0, steps.1)
 }
 
-/// The walk of [`trace_any`], telling `counter` of each node and triangle test.
+/// The walk of [`trace_any`] and [`trace_segment`] (`walk_any` of traverse.wgsl), telling
+/// `counter` of each node and triangle test: every plane padded by `t_pad`, every far end
+/// scaled by `far_scale`.
 #[inline]
-fn walk_any(bvh: &Bvh, origin: Vec3, dir: Vec3, tmax: f32, counter: &mut impl WalkCounter) -> bool {
-    let Some(r) = TraceRay::new(origin, dir) else {
+fn walk_any(
+    bvh: &Bvh,
+    origin: Vec3,
+    dir: Vec3,
+    tmax: f32,
+    t_pad: f32,
+    far_scale: f32,
+    counter: &mut impl WalkCounter,
+) -> bool {
+    let Some(r) = TraceRay::new(origin, dir, t_pad) else {
         return false;
     };
     let tmax = finite_tmax(tmax);
@@ -456,7 +537,7 @@ fn walk_any(bvh: &Bvh, origin: Vec3, dir: Vec3, tmax: f32, counter: &mut impl Wa
         counter.node();
         let n = &bvh.nodes[node as usize];
         let mut next = NO_HIT;
-        if box_hit(n.a_min, n.a_max, &r, tmax) {
+        if box_hit(n.a_min, n.a_max, &r, tmax, far_scale) {
             if n.a_count > 0 {
                 if leaf_any(bvh, n.a_index, n.a_count, &r, tmax, counter) {
                     return true;
@@ -465,7 +546,7 @@ fn walk_any(bvh: &Bvh, origin: Vec3, dir: Vec3, tmax: f32, counter: &mut impl Wa
                 next = n.a_index;
             }
         }
-        if box_hit(n.b_min, n.b_max, &r, tmax) {
+        if box_hit(n.b_min, n.b_max, &r, tmax, far_scale) {
             if n.b_count > 0 {
                 if leaf_any(bvh, n.b_index, n.b_count, &r, tmax, counter) {
                     return true;
@@ -497,7 +578,7 @@ pub fn brute_force_closest(
     dir: Vec3,
     tmax: f32,
 ) -> Option<(u32, f32)> {
-    let r = TraceRay::new(origin, dir)?;
+    let r = TraceRay::new(origin, dir, 0.0)?;
     let mut best = None;
     let mut t_best = tmax;
     for (i, tri) in triangles.iter().enumerate() {
@@ -511,7 +592,7 @@ pub fn brute_force_closest(
 
 /// Whether any triangle is hit with 0 < t < tmax, with the BVH's triangle test.
 pub fn brute_force_any(triangles: &[[Vec3; 3]], origin: Vec3, dir: Vec3, tmax: f32) -> bool {
-    let Some(r) = TraceRay::new(origin, dir) else {
+    let Some(r) = TraceRay::new(origin, dir, 0.0) else {
         return false;
     };
     triangles

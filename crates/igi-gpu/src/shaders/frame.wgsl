@@ -156,7 +156,7 @@ fn direct_irradiance(stack: ptr<function, WalkStack>, p: vec3<f32>, ng: vec3<f32
             continue;
         }
         traced += 1u;
-        if (trace_any(stack, origin, light.position - origin, 1.0)) {
+        if (trace_segment(stack, origin, light.position - origin, false)) {
             continue;
         }
         e += light.intensity * cos_x / dist2;

@@ -124,7 +124,7 @@ fn vpl_irradiance(stack: ptr<function, WalkStack>, p: vec3<f32>, ng: vec3<f32>, 
         // faster on the H200 (docs/PERFORMANCE.md attempt 81).
         let origin = offset_ray_origin(p, ng, params.ray_offset_floor);
         traced += 1u;
-        if (trace_shadow(stack, origin, end - origin, 1.0, IMPERFECT_VISIBILITY)) {
+        if (trace_segment(stack, origin, end - origin, IMPERFECT_VISIBILITY)) {
             continue;
         }
         e += vpl.flux * vpl.albedo * (g / PI);

@@ -25,7 +25,7 @@ const STACK_SIZE: u32 = 60u;
 // The traversal stack. The walks take it by pointer from their caller, which declares
 // one per invocation, outside its loops over rays: WGSL zero-initialises a function's
 // variables where they are declared (naga writes a null initializer, which the NVIDIA
-// driver did not remove), so a stack declared in trace_shadow cost every walk 240 bytes
+// driver did not remove), so a stack declared in the walk cost every walk 240 bytes
 // of stores: 2.6% of a canonical frame on the H200 (docs/PERFORMANCE.md attempt 89). A
 // walk never reads an entry it did not push, so one stack serves any number of walks.
 alias WalkStack = array<u32, STACK_SIZE>;
@@ -40,8 +40,12 @@ const PARALLEL_INV: f32 = 1e30;
 const PARALLEL_SLACK: f32 = 0.00000095367431640625;
 // Relative pad of box_span's per-ray plane offsets (2^-21; igi_core's SLAB_PAD).
 const SLAB_PAD: f32 = 0.000000476837158203125;
-// 1 + 2 gamma(3), rounded to f32 (1 + 3 ulp): conservative far end of a slab.
+// 1 + 2 gamma(3), rounded to f32 (1 + 3 ulp): conservative far end of a slab, for rays
+// of any length (trace_closest, trace_any).
 const BOX_TFAR_SCALE: f32 = 1.0000003576278687;
+// Absolute pad of a segment walk's planes (2^-21 of its length; igi_core's SEGMENT_PAD):
+// in place of BOX_TFAR_SCALE where tmax = 1 (trace_segment).
+const SEGMENT_PAD: f32 = 0.000000476837158203125;
 
 // Wächter-Binder offset constants: near-origin threshold, absolute offset, ulp count.
 const OFFSET_ORIGIN: f32 = 0.03125;
@@ -70,7 +74,8 @@ struct TraceRay {
     kz: u32,
     // box_span's offsets for the planes of a box's min corner and of its max corner: a
     // plane b is crossed at t = fma(b, inv_dir, c), c being -origin inv_dir moved outward
-    // by SLAB_PAD, from the origin moved by the slack along parallel axes.
+    // by SLAB_PAD (and by SEGMENT_PAD for segments), from the origin moved by the slack
+    // along parallel axes.
     c_min: vec3<f32>,
     c_max: vec3<f32>,
 }
@@ -81,7 +86,8 @@ struct ShadowSegment {
     dir: vec3<f32>,
 }
 
-fn make_ray(origin: vec3<f32>, dir: vec3<f32>) -> TraceRay {
+// t_pad: an absolute pad of every plane (SEGMENT_PAD for segment walks, else 0).
+fn make_ray(origin: vec3<f32>, dir: vec3<f32>, t_pad: f32) -> TraceRay {
     let parallel = abs(dir) < vec3<f32>(DIR_EPS);
     // Divide by 1 in parallel lanes so that no lane ever computes 1 / 0.
     let inv_dir = select(vec3<f32>(1.0) / select(dir, vec3<f32>(1.0), parallel), vec3<f32>(PARALLEL_INV), parallel);
@@ -104,7 +110,7 @@ fn make_ray(origin: vec3<f32>, dir: vec3<f32>) -> TraceRay {
     let shear = vec3<f32>(dir[kx] / dir[kz], dir[ky] / dir[kz], 1.0 / dir[kz]);
     let slack = select(vec3<f32>(0.0), (abs(origin) + 1.0) * PARALLEL_SLACK, parallel);
     let oi = origin * inv_dir;
-    let pad = select(abs(oi) * SLAB_PAD, vec3<f32>(0.0), parallel);
+    let pad = select(abs(oi) * SLAB_PAD + t_pad, vec3<f32>(0.0), parallel);
     // The min corner's planes are entry planes where inv_dir > 0 (parallel axes
     // included: measured from the origin moved up by the slack, and moved down by the
     // pad), exit planes where it is < 0 (moved up by the pad); the max corner's the
@@ -120,8 +126,8 @@ fn make_ray(origin: vec3<f32>, dir: vec3<f32>) -> TraceRay {
 
 // Where the ray crosses a box's slabs: per axis the nearer and the farther plane's
 // distance, each one fused multiply-add with the ray's padded offsets (box_span says
-// why). Both box tests take their distances from here: box_span for the walks,
-// box_crossed for imperfect visibility.
+// why), as float minima and maxima for box_crossed (imperfect visibility). box_span
+// computes the same distances and takes their minima and maxima on integer bits.
 struct SlabSpans {
     near: vec3<f32>,
     far: vec3<f32>,
@@ -143,27 +149,34 @@ fn slab_spans(bmin: vec3<f32>, bmax: vec3<f32>, r: TraceRay) -> SlabSpans {
 // offsets (igi_core's SLAB_PAD says why that stays conservative; one subtraction fewer
 // per plane than (b - o) * inv made canonical frames 2.3% faster, attempt 93). Parallel
 // axes need no case of their own: their offsets hold the moved origins (the select this
-// replaced cost 6-10% of every walk, attempt 35).
-fn box_span(bmin: vec3<f32>, bmax: vec3<f32>, r: TraceRay, tmax: f32) -> vec2<f32> {
-    let slabs = slab_spans(bmin, bmax, r);
-    let tn = slabs.near;
-    let tf = slabs.far;
-    let near = max(max(tn.x, tn.y), max(tn.z, 0.0));
-    let far = min(min(min(tf.x, tf.y), tf.z) * BOX_TFAR_SCALE, tmax);
-    return vec2<f32>(near, far);
+// replaced cost 6-10% of every walk, attempt 35). The far end is scaled by far_scale:
+// BOX_TFAR_SCALE, or 1 on a segment walk, whose planes are padded instead
+// (SEGMENT_PAD).
+// The minima and maxima are taken on the distances' bits as signed integers, which order
+// like the floats they are wherever the answer depends on it (igi_core's box_span says
+// why): with float min and max, the walks ran 1-6% slower on the H200, with the same
+// answers (docs/PERFORMANCE.md attempt 104).
+fn box_span(bmin: vec3<f32>, bmax: vec3<f32>, r: TraceRay, tmax: f32, far_scale: f32) -> vec2<f32> {
+    let t0 = bitcast<vec3<i32>>(fma(bmin, r.inv_dir, r.c_min));
+    let t1 = bitcast<vec3<i32>>(fma(bmax, r.inv_dir, r.c_max));
+    let tn = min(t0, t1);
+    let tf = max(t0, t1);
+    let near = max(max(tn.x, tn.y), max(tn.z, 0));
+    let far = min(bitcast<f32>(min(min(tf.x, tf.y), tf.z)) * far_scale, tmax);
+    return vec2<f32>(bitcast<f32>(near), far);
 }
 
 // The entry distance (>= 0) of a box hit within [0, tmax], or -1 (closest hits order
 // and prune children by it).
 fn box_near(bmin: vec3<f32>, bmax: vec3<f32>, r: TraceRay, tmax: f32) -> f32 {
-    let span = box_span(bmin, bmax, r, tmax);
+    let span = box_span(bmin, bmax, r, tmax, BOX_TFAR_SCALE);
     return select(-1.0, span.x, span.x <= span.y);
 }
 
 // Whether a box is hit within [0, tmax] (any hit needs no distance: without the select
 // and the compare that box_near's -1 costs, walks ran 1-2% faster, attempt 36).
-fn box_hit(bmin: vec3<f32>, bmax: vec3<f32>, r: TraceRay, tmax: f32) -> bool {
-    let span = box_span(bmin, bmax, r, tmax);
+fn box_hit(bmin: vec3<f32>, bmax: vec3<f32>, r: TraceRay, tmax: f32, far_scale: f32) -> bool {
+    let span = box_span(bmin, bmax, r, tmax, far_scale);
     return span.x <= span.y;
 }
 
@@ -307,7 +320,7 @@ fn trace_closest(stack: ptr<function, WalkStack>, origin: vec3<f32>, dir: vec3<f
     if (all(dir == vec3<f32>(0.0))) {
         return hit;
     }
-    let r = make_ray(origin, dir);
+    let r = make_ray(origin, dir, 0.0);
     var sp = 0u;
     var node = 0u;
     loop {
@@ -362,18 +375,19 @@ fn trace_closest(stack: ptr<function, WalkStack>, origin: vec3<f32>, dir: vec3<f
 // 2.7% faster than the child of more triangle area, attempt 80, which was 3% faster than
 // the larger box first, attempt 41, which was 9-15% faster than the split's order).
 // With `boxes` (imperfect visibility), a triangle whose box the segment crosses counts
-// as a hit (see box_crossed).
-fn trace_shadow(stack: ptr<function, WalkStack>, origin: vec3<f32>, dir: vec3<f32>, tmax: f32, boxes: bool) -> bool {
+// as a hit (see box_crossed). The callers below pick the far end's margin: t_pad and
+// far_scale are constants there, so each compiles to a walk of its own.
+fn walk_any(stack: ptr<function, WalkStack>, origin: vec3<f32>, dir: vec3<f32>, tmax: f32, boxes: bool, t_pad: f32, far_scale: f32) -> bool {
     if (all(dir == vec3<f32>(0.0))) {
         return false;
     }
-    let r = make_ray(origin, dir);
+    let r = make_ray(origin, dir, t_pad);
     var sp = 0u;
     var node = 0u;
     loop {
         let n = bvh_nodes[node];
-        let hit_a = box_hit(n.a_min, n.a_max, r, tmax);
-        let hit_b = box_hit(n.b_min, n.b_max, r, tmax);
+        let hit_a = box_hit(n.a_min, n.a_max, r, tmax, far_scale);
+        let hit_b = box_hit(n.b_min, n.b_max, r, tmax, far_scale);
         var next = NO_HIT;
         if (hit_a) {
             if (n.a_count > 0u) {
@@ -408,9 +422,20 @@ fn trace_shadow(stack: ptr<function, WalkStack>, origin: vec3<f32>, dir: vec3<f3
     return false;
 }
 
-// Exact any-hit query (see trace_shadow).
+// Exact any-hit query of a ray of any length (0 < t < tmax, tmax up to 3.4e38): the far
+// end scaled by BOX_TFAR_SCALE (see walk_any).
 fn trace_any(stack: ptr<function, WalkStack>, origin: vec3<f32>, dir: vec3<f32>, tmax: f32) -> bool {
-    return trace_shadow(stack, origin, dir, tmax, false);
+    return walk_any(stack, origin, dir, tmax, false, 0.0, BOX_TFAR_SCALE);
+}
+
+// Whether the segment from origin to origin + dir is occluded (0 < t < 1; see walk_any):
+// the renderer's shadow rays (shadow_segment). A segment's planes are padded by the
+// constant SEGMENT_PAD instead of scaling every far end by BOX_TFAR_SCALE: one product
+// fewer per box, and canonical frames 1.5% faster on the H200 (docs/PERFORMANCE.md
+// attempt 104; igi_core's SEGMENT_PAD says why it stays conservative). `boxes`: imperfect
+// visibility.
+fn trace_segment(stack: ptr<function, WalkStack>, origin: vec3<f32>, dir: vec3<f32>, boxes: bool) -> bool {
+    return walk_any(stack, origin, dir, 1.0, boxes, SEGMENT_PAD, 1.0);
 }
 
 // Origin for a ray leaving a surface at p, n the unit geometric normal on the side the
@@ -426,8 +451,8 @@ fn offset_ray_origin(p: vec3<f32>, n: vec3<f32>, floor: f32) -> vec3<f32> {
 }
 
 // Shadow ray from surface point x (normal nx) to surface point y (normal ny), both ends
-// offset along their normals turned toward the other point. Trace it with tmax = 1: dir
-// is y' - x', not normalised, so t is in units of the segment.
+// offset along their normals turned toward the other point. Trace it with trace_segment:
+// dir is y' - x', not normalised, so t is in units of the segment.
 fn shadow_segment(x: vec3<f32>, nx: vec3<f32>, y: vec3<f32>, ny: vec3<f32>, floor: f32) -> ShadowSegment {
     let d = y - x;
     let ox = offset_ray_origin(x, select(nx, -nx, dot(nx, d) < 0.0), floor);
