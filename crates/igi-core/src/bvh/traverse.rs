@@ -89,8 +89,8 @@ pub(crate) const BOX_TFAR_SCALE: f32 = 1.0 + 3.0 * f32::EPSILON;
 /// segment walk visits every box the exact test would, as the scaled walk does, and both
 /// answer what the triangle tests answer. It does not hold for long rays (a ray of tmax
 /// 3.4e38 would need a pad that opens every box), which keep the scale ([`trace_any`]).
-/// The renderer's shadow rays are all segments (`shadow_segment`); their walk ran 1.5%
-/// faster on the H200 (docs/PERFORMANCE.md attempt 104).
+/// The renderer's shadow rays are all segments (`shadow_segment`); their walk made
+/// canonical frames 1.2-1.4% faster on the H200 (docs/PERFORMANCE.md attempt 104).
 pub(crate) const SEGMENT_PAD: f32 = 1.0 / 2_097_152.0;
 
 /// Wächter-Binder offset: distance below which coordinates get an absolute offset.

@@ -431,7 +431,7 @@ fn trace_any(stack: ptr<function, WalkStack>, origin: vec3<f32>, dir: vec3<f32>,
 // Whether the segment from origin to origin + dir is occluded (0 < t < 1; see walk_any):
 // the renderer's shadow rays (shadow_segment). A segment's planes are padded by the
 // constant SEGMENT_PAD instead of scaling every far end by BOX_TFAR_SCALE: one product
-// fewer per box, and canonical frames 1.5% faster on the H200 (docs/PERFORMANCE.md
+// fewer per box, and canonical frames 1.2-1.4% faster on the H200 (docs/PERFORMANCE.md
 // attempt 104; igi_core's SEGMENT_PAD says why it stays conservative). `boxes`: imperfect
 // visibility.
 fn trace_segment(stack: ptr<function, WalkStack>, origin: vec3<f32>, dir: vec3<f32>, boxes: bool) -> bool {
