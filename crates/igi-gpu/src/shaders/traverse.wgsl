@@ -376,7 +376,7 @@ fn trace_closest(stack: ptr<function, WalkStack>, origin: vec3<f32>, dir: vec3<f
 // the larger box first, attempt 41, which was 9-15% faster than the split's order).
 // With `boxes` (imperfect visibility), a triangle whose box the segment crosses counts
 // as a hit (see box_crossed). The callers below pick the far end's margin: t_pad and
-// far_scale are constants there, so each compiles to a walk of its own.
+// far_scale are constants there, which the compiler can fold into each walk.
 fn walk_any(stack: ptr<function, WalkStack>, origin: vec3<f32>, dir: vec3<f32>, tmax: f32, boxes: bool, t_pad: f32, far_scale: f32) -> bool {
     if (all(dir == vec3<f32>(0.0))) {
         return false;
