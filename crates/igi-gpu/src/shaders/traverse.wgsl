@@ -124,19 +124,29 @@ fn make_ray(origin: vec3<f32>, dir: vec3<f32>, t_pad: f32) -> TraceRay {
     return TraceRay(origin_k, inv_dir, shear, kx, ky, kz, c_min, c_max);
 }
 
+// The distances at which the ray crosses the planes of a box's min corner (t0) and of its
+// max corner (t1), each one fused multiply-add with the ray's padded offsets (box_span
+// says why): the twin of igi_core's TraceRay::plane_distances. box_span orders them on
+// integer bits for the walks, slab_spans as floats for box_crossed.
+struct PlaneDistances {
+    t0: vec3<f32>,
+    t1: vec3<f32>,
+}
+
+fn plane_distances(bmin: vec3<f32>, bmax: vec3<f32>, r: TraceRay) -> PlaneDistances {
+    return PlaneDistances(fma(bmin, r.inv_dir, r.c_min), fma(bmax, r.inv_dir, r.c_max));
+}
+
 // Where the ray crosses a box's slabs: per axis the nearer and the farther plane's
-// distance, each one fused multiply-add with the ray's padded offsets (box_span says
-// why), as float minima and maxima for box_crossed (imperfect visibility). box_span
-// computes the same distances and takes their minima and maxima on integer bits.
+// distance, as float minima and maxima for box_crossed (imperfect visibility).
 struct SlabSpans {
     near: vec3<f32>,
     far: vec3<f32>,
 }
 
 fn slab_spans(bmin: vec3<f32>, bmax: vec3<f32>, r: TraceRay) -> SlabSpans {
-    let t0 = fma(bmin, r.inv_dir, r.c_min);
-    let t1 = fma(bmax, r.inv_dir, r.c_max);
-    return SlabSpans(min(t0, t1), max(t0, t1));
+    let d = plane_distances(bmin, bmax, r);
+    return SlabSpans(min(d.t0, d.t1), max(d.t0, d.t1));
 }
 
 // Slab test: (entry, exit) distances of a box clipped to [0, tmax]; the box is hit when
@@ -157,8 +167,9 @@ fn slab_spans(bmin: vec3<f32>, bmax: vec3<f32>, r: TraceRay) -> SlabSpans {
 // why): with float min and max, the walks ran 1-6% slower on the H200, with the same
 // answers (docs/PERFORMANCE.md attempt 104).
 fn box_span(bmin: vec3<f32>, bmax: vec3<f32>, r: TraceRay, tmax: f32, far_scale: f32) -> vec2<f32> {
-    let t0 = bitcast<vec3<i32>>(fma(bmin, r.inv_dir, r.c_min));
-    let t1 = bitcast<vec3<i32>>(fma(bmax, r.inv_dir, r.c_max));
+    let d = plane_distances(bmin, bmax, r);
+    let t0 = bitcast<vec3<i32>>(d.t0);
+    let t1 = bitcast<vec3<i32>>(d.t1);
     let tn = min(t0, t1);
     let tf = max(t0, t1);
     let near = max(max(tn.x, tn.y), max(tn.z, 0));
