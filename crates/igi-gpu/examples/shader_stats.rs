@@ -40,6 +40,8 @@ fn run() -> Result<(), String> {
         naga::valid::ValidationFlags::all(),
         naga::valid::Capabilities::all(),
     )
+    .subgroup_stages(naga::valid::ShaderStages::COMPUTE)
+    .subgroup_operations(naga::valid::SubgroupOperationSet::all())
     .validate(&module)
     .map_err(|e| format!("{e:?}"))?;
     let mut overrides = naga::back::PipelineConstants::default();

@@ -79,6 +79,8 @@ pub struct GpuContext {
     pub info: wgpu::AdapterInfo,
     /// Whether GPU timestamp queries (per-stage timings) are available.
     pub timestamps: bool,
+    /// Whether the device has WGSL subgroup operations (`Features::SUBGROUP`).
+    pub subgroups: bool,
     /// The first uncaptured error (validation, out of memory) seen on the device, if any.
     errors: Arc<Mutex<Option<GpuError>>>,
     /// Why the device was lost, if it was: reported before any error it causes.
@@ -215,6 +217,10 @@ impl GpuContext {
                 features |= wgpu::Features::TIMESTAMP_QUERY_INSIDE_PASSES;
             }
         }
+        let subgroups = adapter.features().contains(wgpu::Features::SUBGROUP);
+        if subgroups {
+            features |= wgpu::Features::SUBGROUP;
+        }
         let desc = wgpu::DeviceDescriptor {
             label: Some("igi"),
             required_features: features,
@@ -251,6 +257,7 @@ impl GpuContext {
             queue,
             info,
             timestamps,
+            subgroups,
             errors,
             lost,
         })

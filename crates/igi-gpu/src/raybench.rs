@@ -1,13 +1,16 @@
 //! The ray-tracing layer measured alone (`igi bench rays`): a ray file traced with the
 //! any-hit or closest-hit query of `traverse.wgsl`, timed with timestamp queries, so that
 //! another ray tracer (OptiX through Mitsuba, `shared/tools/optix_peer.py`) can trace the
-//! very same rays and be compared ray for ray.
+//! very same rays and be compared ray for ray. Any hit has two schedules
+//! ([`RaySchedule`]): one ray per thread for coherent batches, persistent subgroups that
+//! refill their idle lanes (Aila and Laine 2009, `rays_refill.wgsl`) for incoherent ones.
 
 use crate::context::{GpuContext, GpuError};
 use crate::layout::FrameParams;
 use crate::passes::{bind, pass_layout, pipeline};
 use crate::profiler::Profiler;
 use crate::scene_buffers::{storage_buffer, SceneBuffers, READ, UNIFORM, WRITE};
+use glam::Vec3;
 use igi_core::bvh::Bvh;
 use igi_core::rays::RayRecord;
 use igi_core::scene::Scene;
@@ -17,6 +20,72 @@ pub const WARMUP_RUNS: u32 = 3;
 
 /// Threads per workgroup of the ray kernels (`RAY_GROUP` in rays.wgsl).
 const RAY_GROUP: u32 = 64;
+
+/// Workgroups of a refill dispatch, whatever the batch: more than the largest GPUs hold at
+/// once (an H100 holds about 3,200 of these), since workgroups that start after the batch
+/// is handed out leave at once. On an H100's random segments 4,096, 8,192 and 16,384
+/// measured within 0.7% of each other, 2,112 and 1,056 2.5% and 24% slower
+/// (docs/PERFORMANCE.md attempt 110).
+const REFILL_GROUPS: u32 = 8192;
+
+/// How the any-hit kernel hands rays to threads.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RaySchedule {
+    /// One ray per thread, in batch order (`any_hit` of rays.wgsl): best where
+    /// neighbouring rays walk alike, as the renderer's VPL-major shadow rays do.
+    PerThread,
+    /// Persistent subgroups that hand idle lanes the next rays (`rays_refill.wgsl`): best
+    /// for incoherent batches, whose warps otherwise wait for their longest walk. Needs
+    /// subgroup operations ([`GpuContext::subgroups`]).
+    Refill,
+}
+
+impl RaySchedule {
+    /// The schedule for a batch: [`RaySchedule::Refill`] unless most neighbouring rays in
+    /// it are alike (see [`coherent_fraction`]) or the device has no subgroup operations.
+    pub fn for_batch(
+        ctx: &GpuContext,
+        rays: &[RayRecord],
+        scene_lo: Vec3,
+        scene_hi: Vec3,
+    ) -> RaySchedule {
+        if ctx.subgroups && coherent_fraction(rays, scene_lo, scene_hi) < 0.5 {
+            RaySchedule::Refill
+        } else {
+            RaySchedule::PerThread
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            RaySchedule::PerThread => "one ray per thread",
+            RaySchedule::Refill => "refilled subgroups",
+        }
+    }
+}
+
+/// Of (up to 65,536 evenly spread) pairs of neighbouring rays in a batch, the fraction
+/// that are alike: origins within 1% of the scene box's diagonal of each other and
+/// directions within about 8 degrees (cosine > 0.99). The renderer's frame set (a warp's
+/// worth of neighbouring pixels to one VPL) is mostly alike; random segments are not.
+pub fn coherent_fraction(rays: &[RayRecord], scene_lo: Vec3, scene_hi: Vec3) -> f64 {
+    let pairs = rays.len().saturating_sub(1);
+    if pairs == 0 {
+        return 1.0;
+    }
+    let near = 0.01 * (scene_hi - scene_lo).length();
+    let step = pairs.div_ceil(65_536);
+    let (mut alike, mut seen) = (0u64, 0u64);
+    for i in (0..pairs).step_by(step) {
+        let (a, b) = (&rays[i], &rays[i + 1]);
+        let (da, db) = (Vec3::from(a.dir), Vec3::from(b.dir));
+        let close = Vec3::from(a.origin).distance(Vec3::from(b.origin)) <= near;
+        let cos = da.dot(db) / (da.length() * db.length());
+        seen += 1;
+        alike += u64::from(close && cos > 0.99);
+    }
+    alike as f64 / seen as f64
+}
 
 /// The query to run.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -45,6 +114,11 @@ pub struct RayBench {
     layout: wgpu::BindGroupLayout,
     any_hit: wgpu::ComputePipeline,
     closest_hit: wgpu::ComputePipeline,
+    /// The refill schedule's bindings (those of `any_hit` and the ray counter) and
+    /// pipeline; None without subgroup operations.
+    refill: Option<(wgpu::BindGroupLayout, wgpu::ComputePipeline)>,
+    /// Most workgroups of a refill dispatch ([`REFILL_GROUPS`]).
+    refill_groups: u32,
     params: wgpu::Buffer,
     tri_order: Vec<u32>,
 }
@@ -63,7 +137,19 @@ impl RayBench {
                 usage: wgpu::BufferUsages::UNIFORM,
             },
         );
+        let refill = ctx.subgroups.then(|| {
+            let layout = pass_layout(&ctx.device, "rays refill", &[UNIFORM, READ, WRITE, WRITE]);
+            let refill = pipeline(
+                &ctx.device,
+                "rays_refill",
+                "any_hit_refill",
+                &[&scene_buffers.layout, &layout],
+            );
+            (layout, refill)
+        });
         Ok(RayBench {
+            refill,
+            refill_groups: REFILL_GROUPS,
             any_hit: pipeline(&ctx.device, "rays", "any_hit", &layouts),
             closest_hit: pipeline(&ctx.device, "rays", "closest_hit", &layouts),
             scene: scene_buffers,
@@ -73,15 +159,34 @@ impl RayBench {
         })
     }
 
+    /// At most `groups` (>= 1) workgroups per refill dispatch instead of [`REFILL_GROUPS`]:
+    /// with few of them each lane takes many rays, as on a full GPU (the tests use it).
+    pub fn set_refill_groups(&mut self, groups: u32) {
+        self.refill_groups = groups.max(1);
+    }
+
     /// Trace `rays` [`WARMUP_RUNS`] times untimed (the GPU's clocks rise meanwhile), then
-    /// `runs` times timed; results of the last run.
+    /// `runs` times timed; results of the last run. `schedule` applies to any hit (closest
+    /// hits always run one ray per thread); [`RaySchedule::Refill`] needs subgroups.
     pub fn trace(
         &self,
         ctx: &GpuContext,
         rays: &[RayRecord],
         query: RayQuery,
+        schedule: RaySchedule,
         runs: u32,
     ) -> Result<RayTiming, GpuError> {
+        let refill = match (query, schedule) {
+            (RayQuery::AnyHit, RaySchedule::Refill) => {
+                Some(self.refill.as_ref().ok_or_else(|| {
+                    GpuError::Device(format!(
+                        "adapter '{}' has no subgroup operations, which the refill schedule needs",
+                        ctx.info.name
+                    ))
+                })?)
+            }
+            _ => None,
+        };
         // Batches that fit one storage binding (128 MiB on lavapipe).
         let per_batch = (ctx.max_storage_binding() / 32).min(1 << 24) as usize;
         let words = if query == RayQuery::AnyHit { 1 } else { 2 };
@@ -94,18 +199,39 @@ impl RayBench {
                 Ok((input, output, chunk.len() as u32))
             })
             .collect::<Result<_, GpuError>>()?;
+        // The refill schedule's ray counters, one per batch, zeroed before each run.
+        let counters: Vec<wgpu::Buffer> = match refill {
+            Some(_) => batches
+                .iter()
+                .map(|_| storage_buffer(ctx, "ray counter", &[0u8; 4]))
+                .collect::<Result<_, GpuError>>()?,
+            None => vec![],
+        };
         let binds: Vec<wgpu::BindGroup> = batches
             .iter()
-            .map(|(i, o, _)| bind(&ctx.device, "rays", &self.layout, &[&self.params, i, o]))
+            .enumerate()
+            .map(|(k, (i, o, _))| match refill {
+                Some((layout, _)) => bind(
+                    &ctx.device,
+                    "rays refill",
+                    layout,
+                    &[&self.params, i, o, &counters[k]],
+                ),
+                None => bind(&ctx.device, "rays", &self.layout, &[&self.params, i, o]),
+            })
             .collect();
-        let pipeline = match query {
-            RayQuery::AnyHit => &self.any_hit,
-            RayQuery::ClosestHit => &self.closest_hit,
+        let pipeline = match (query, refill) {
+            (RayQuery::AnyHit, Some((_, refill))) => refill,
+            (RayQuery::AnyHit, None) => &self.any_hit,
+            (RayQuery::ClosestHit, _) => &self.closest_hit,
         };
         let profiler = Profiler::new(ctx, 1);
         let mut runs_ms = vec![];
         for run in 0..WARMUP_RUNS + runs {
             let mut encoder = ctx.device.create_command_encoder(&Default::default());
+            for counter in &counters {
+                encoder.clear_buffer(counter, 0, None);
+            }
             {
                 let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                     label: Some("rays"),
@@ -115,7 +241,10 @@ impl RayBench {
                 pass.set_bind_group(0, &self.scene.bind_group, &[]);
                 for (bg, (_, _, n)) in binds.iter().zip(&batches) {
                     pass.set_bind_group(1, bg, &[]);
-                    let groups = n.div_ceil(RAY_GROUP);
+                    let mut groups = n.div_ceil(RAY_GROUP);
+                    if refill.is_some() {
+                        groups = groups.min(self.refill_groups);
+                    }
                     let x = groups.min(65535);
                     pass.dispatch_workgroups(x, groups.div_ceil(x), 1);
                 }

@@ -11,23 +11,37 @@ use igi_gpu::layout::{
 use std::mem::{offset_of, size_of};
 
 fn parse_and_validate(name: &str, src: &str) -> naga::Module {
+    validate_with(name, src, false)
+}
+
+/// Parses and validates with naga's default capabilities, plus subgroup operations in
+/// compute shaders where `subgroups` (only passes that declare them may use them).
+fn validate_with(name: &str, src: &str, subgroups: bool) -> naga::Module {
     let module = naga::front::wgsl::parse_str(src)
         .unwrap_or_else(|e| panic!("{name}.wgsl does not parse:\n{}", e.emit_to_string(src)));
-    naga::valid::Validator::new(
-        naga::valid::ValidationFlags::all(),
-        naga::valid::Capabilities::default(),
-    )
-    .validate(&module)
-    .unwrap_or_else(|e| panic!("{name}.wgsl does not validate:\n{}", e.emit_to_string(src)));
+    let mut capabilities = naga::valid::Capabilities::default();
+    if subgroups {
+        capabilities |= naga::valid::Capabilities::SUBGROUP;
+    }
+    let mut validator =
+        naga::valid::Validator::new(naga::valid::ValidationFlags::all(), capabilities);
+    if subgroups {
+        validator
+            .subgroup_stages(naga::valid::ShaderStages::COMPUTE)
+            .subgroup_operations(naga::valid::SubgroupOperationSet::all());
+    }
+    validator
+        .validate(&module)
+        .unwrap_or_else(|e| panic!("{name}.wgsl does not validate:\n{}", e.emit_to_string(src)));
     module
 }
 
 #[test]
 fn every_pass_shader_validates() {
-    let shaders = igi_gpu::shader::all_shaders();
-    assert!(shaders.len() >= 4);
-    for (name, src) in shaders {
-        parse_and_validate(name, &src);
+    let passes = igi_gpu::passes::SOURCES;
+    assert!(passes.len() >= 4);
+    for pass in passes {
+        validate_with(pass.name, &igi_gpu::shader::compose(pass), pass.subgroups);
     }
 }
 

@@ -78,6 +78,18 @@ enum RaySetArg {
     Frame,
 }
 
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum ScheduleArg {
+    /// Refilled subgroups unless most neighbouring rays are alike (and the adapter has
+    /// subgroup operations); else one ray per thread.
+    Auto,
+    /// One ray per thread, in file order: best for coherent batches.
+    PerThread,
+    /// Persistent subgroups that refill idle lanes: best for incoherent batches (needs
+    /// subgroup operations).
+    Refill,
+}
+
 #[derive(Args)]
 struct RaysArgs {
     /// The scene file (TOML), or builtin:NAME.
@@ -100,6 +112,9 @@ struct RaysArgs {
     /// Timed runs after one warm-up; the median is reported.
     #[arg(long, default_value_t = 10)]
     runs: u32,
+    /// How the any-hit query hands rays to GPU threads (closest hits: one per thread).
+    #[arg(long, value_enum, default_value = "auto")]
+    schedule: ScheduleArg,
     /// VPLs of the frame set.
     #[arg(long, default_value_t = 180)]
     vpls: u32,
@@ -708,7 +723,7 @@ fn bench(args: &BenchArgs) -> Result<()> {
 
 fn bench_rays(args: &RaysArgs) -> Result<()> {
     use igi_core::rays::{random_rays, random_segments, read_rays, write_rays};
-    use igi_gpu::raybench::{RayBench, RayQuery};
+    use igi_gpu::raybench::{coherent_fraction, RayBench, RayQuery, RaySchedule};
     if args.count == 0 {
         bail!("--count must be at least 1");
     }
@@ -717,6 +732,9 @@ fn bench_rays(args: &RaysArgs) -> Result<()> {
     }
     if args.set == RaySetArg::Frame && args.kind != RayKindArg::Shadow && args.load.is_none() {
         bail!("the frame set holds shadow rays: use --kind shadow");
+    }
+    if args.schedule == ScheduleArg::Refill && args.kind == RayKindArg::Closest {
+        bail!("--schedule refill applies to shadow rays (any hit): give --kind shadow or both");
     }
     let scene = igi::bench::run::load(&args.scene)?;
     let t = Instant::now();
@@ -727,6 +745,12 @@ fn bench_rays(args: &RaysArgs) -> Result<()> {
     if !ctx.timestamps {
         bail!(
             "adapter '{}' has no timestamp queries: igi bench rays needs them",
+            ctx.info.name
+        );
+    }
+    if args.schedule == ScheduleArg::Refill && !ctx.subgroups {
+        bail!(
+            "adapter '{}' has no subgroup operations, which --schedule refill needs: use --schedule per-thread",
             ctx.info.name
         );
     }
@@ -768,13 +792,33 @@ fn bench_rays(args: &RaysArgs) -> Result<()> {
             write_rays(path, &rays)?;
             eprintln!("wrote {} rays to {}", rays.len(), path.display());
         }
-        let timing = bench.trace(&ctx, &rays, query, args.runs.max(1))?;
+        let schedule = match args.schedule {
+            ScheduleArg::Auto => {
+                let (lo, hi) = bvh.bounds();
+                RaySchedule::for_batch(&ctx, &rays, lo, hi)
+            }
+            ScheduleArg::PerThread => RaySchedule::PerThread,
+            ScheduleArg::Refill => RaySchedule::Refill,
+        };
+        if query == RayQuery::AnyHit {
+            let (lo, hi) = bvh.bounds();
+            let alike = 100.0 * coherent_fraction(&rays, lo, hi);
+            let why = match args.schedule {
+                ScheduleArg::Auto if schedule == RaySchedule::PerThread && !ctx.subgroups => {
+                    "auto: the adapter has no subgroup operations".to_string()
+                }
+                ScheduleArg::Auto => format!("auto: {alike:.1}% of neighbouring rays alike"),
+                _ => format!("asked; {alike:.1}% of neighbouring rays alike"),
+            };
+            eprintln!("any-hit schedule: {} ({why})", schedule.name());
+        }
+        let timing = bench.trace(&ctx, &rays, query, schedule, args.runs.max(1))?;
         let mut runs = timing.runs_ms.clone();
         runs.sort_by(f64::total_cmp);
         let median = runs[runs.len() / 2];
         let name = match query {
-            RayQuery::AnyHit => "shadow (any hit)",
-            RayQuery::ClosestHit => "closest hit",
+            RayQuery::AnyHit => format!("shadow (any hit) by {}", schedule.name()),
+            RayQuery::ClosestHit => "closest hit".to_string(),
         };
         // A hash of every answer, so that two traversals (or builds) of the same ray file
         // can be checked to answer the same, not only to be as fast.

@@ -22,6 +22,9 @@ pub struct PassSource {
     pub gathers: bool,
     /// Whether it is composed with upsample.wgsl (joint bilateral upsampling).
     pub upsamples: bool,
+    /// Whether it uses subgroup operations (built only where the device has
+    /// `Features::SUBGROUP`; validated with naga's subgroup capability).
+    pub subgroups: bool,
 }
 
 /// Each pass's own WGSL, by name (composed with the shared modules by `shader::compose`).
@@ -31,42 +34,60 @@ pub const SOURCES: &[PassSource] = &[
         wgsl: include_str!("../shaders/vpl.wgsl"),
         gathers: false,
         upsamples: false,
+        subgroups: false,
     },
     PassSource {
         name: "direct",
         wgsl: include_str!("../shaders/direct.wgsl"),
         gathers: true,
         upsamples: false,
+        subgroups: false,
     },
     PassSource {
         name: "indirect",
         wgsl: include_str!("../shaders/indirect.wgsl"),
         gathers: true,
         upsamples: false,
+        subgroups: false,
     },
     PassSource {
         name: "filter",
         wgsl: include_str!("../shaders/filter.wgsl"),
         gathers: false,
         upsamples: true,
+        subgroups: false,
     },
     PassSource {
         name: "rays",
         wgsl: include_str!("../shaders/rays.wgsl"),
         gathers: false,
         upsamples: false,
+        subgroups: false,
+    },
+    PassSource {
+        name: "rays_refill",
+        // rays.wgsl's bindings and kernels, then the refill schedule's.
+        wgsl: concat!(
+            include_str!("../shaders/rays.wgsl"),
+            include_str!("../shaders/rays_refill.wgsl")
+        ),
+        gathers: false,
+        upsamples: false,
+        subgroups: true,
     },
     PassSource {
         name: "compose",
         wgsl: include_str!("../shaders/compose.wgsl"),
         gathers: false,
         upsamples: true,
+        subgroups: false,
     },
     PassSource {
         name: "display",
         wgsl: include_str!("../shaders/display.wgsl"),
         gathers: false,
         upsamples: false,
+        subgroups: false,
     },
 ];
 

@@ -1,0 +1,113 @@
+// rays_refill.wgsl: the any-hit query over a ray file for incoherent batches, composed
+// after rays.wgsl (`RaySchedule::Refill` of raybench.rs). Aila and Laine's persistent
+// threads with dynamic ray fetch ("Understanding the Efficiency of Ray Traversal on
+// GPUs", 2009), with subgroup operations: a subgroup walks one node per lane and step,
+// and when enough of its lanes have finished their rays it hands them the next rays of
+// the batch at once (one atomic add per refill). With one ray per thread (any_hit), a
+// warp of random segments runs as long as its longest walk: its lanes walk 21 nodes on
+// average but the warp 58 steps (the CPU model of docs/PERFORMANCE.md attempt 110).
+// The answers are the walk's of trace_any (same functions, same order), ray for ray.
+// CPU twin: igi_core's Bvh::trace_any.
+//
+// Coherent batches (neighbouring rays walk alike, as the renderer's VPL-major shadow
+// rays do) trace faster with one ray per thread: refilled lanes walk apart from the
+// lanes still on their old rays (attempt 110: the frame set 6.27 -> 5.68 G rays/s).
+
+// The next unassigned ray of the batch; zeroed before each dispatch.
+@group(1) @binding(3) var<storage, read_write> ray_counter: atomic<u32>;
+
+// A subgroup refills its idle lanes once at least REFILL_IDLE / 64 of its lanes are idle
+// (or all of its active ones: see any_hit_lanes). 48 (three quarters) measured best
+// among 16, 32 and 48 on an H100's random segments (attempt 110).
+override REFILL_IDLE: u32 = 48u;
+
+fn ballot_count(b: vec4<u32>) -> u32 {
+    return countOneBits(b.x) + countOneBits(b.y) + countOneBits(b.z) + countOneBits(b.w);
+}
+
+// The walk of walk_any (trace_any: no t pad, far ends scaled by BOX_TFAR_SCALE), one
+// node per iteration of a loop that also assigns rays. Correct whatever lanes the
+// driver keeps together: a refill counts and ranks only the lanes active at the ballot,
+// a subgroup whose active lanes are all idle always refills (so none waits for lanes it
+// does not see), and a lane leaves the loop on its own once the batch is exhausted.
+fn any_hit_lanes(stack: ptr<function, WalkStack>, subgroup_size: u32, lane: u32) {
+    let ray_count = arrayLength(&rays) / 2u;
+    var ray = NO_HIT;
+    var more = true;
+    var r: TraceRay;
+    var tmax = 0.0;
+    var node = 0u;
+    var sp = 0u;
+    loop {
+        let idle = ray == NO_HIT;
+        if (idle && !more) {
+            break;
+        }
+        let idle_lanes = ballot_count(subgroupBallot(idle));
+        let active_lanes = ballot_count(subgroupBallot(true));
+        if (more && (64u * idle_lanes >= REFILL_IDLE * subgroup_size || idle_lanes == active_lanes)) {
+            var first = 0u;
+            if (subgroupBroadcastFirst(lane) == lane) {
+                first = atomicAdd(&ray_counter, idle_lanes);
+            }
+            first = subgroupBroadcastFirst(first);
+            more = first + idle_lanes < ray_count;
+            let i = first + subgroupExclusiveAdd(select(0u, 1u, idle));
+            if (idle && i < ray_count) {
+                let a = rays[2u * i];
+                let b = rays[2u * i + 1u];
+                if (all(b.xyz == vec3<f32>(0.0))) {
+                    results[i] = 0u;
+                } else {
+                    ray = i;
+                    r = make_ray(a.xyz, b.xyz, 0.0);
+                    tmax = b.w;
+                    node = 0u;
+                    sp = 0u;
+                }
+            }
+        }
+        if (ray == NO_HIT) {
+            continue;
+        }
+        let n = bvh_nodes[node];
+        let hit_a = box_hit(n.a_min, n.a_max, r, tmax, BOX_TFAR_SCALE);
+        let hit_b = box_hit(n.b_min, n.b_max, r, tmax, BOX_TFAR_SCALE);
+        var next = NO_HIT;
+        var found = false;
+        if (hit_a) {
+            if (n.a_count > 0u) {
+                found = leaf_any(n.a_index, n.a_count, r, tmax, false);
+            } else {
+                next = n.a_index;
+            }
+        }
+        if (hit_b && !found) {
+            if (n.b_count > 0u) {
+                found = leaf_any(n.b_index, n.b_count, r, tmax, false);
+            } else if (next == NO_HIT) {
+                next = n.b_index;
+            } else {
+                (*stack)[sp] = n.b_index;
+                sp += 1u;
+            }
+        }
+        if (!found && next == NO_HIT && sp > 0u) {
+            sp -= 1u;
+            next = (*stack)[sp];
+        }
+        if (found || next == NO_HIT) {
+            results[ray] = select(0u, 1u, found);
+            ray = NO_HIT;
+        } else {
+            node = next;
+        }
+    }
+}
+
+// Dispatched with at most REFILL_GROUPS (raybench.rs) workgroups, whatever the batch size.
+@compute @workgroup_size(64)
+fn any_hit_refill(@builtin(subgroup_size) subgroup_size: u32, @builtin(subgroup_invocation_id) lane: u32) {
+    var stack: WalkStack;
+    any_hit_lanes(&stack, subgroup_size, lane);
+}
