@@ -24,8 +24,8 @@ const RAY_GROUP: u32 = 64;
 /// Workgroups of a refill dispatch, whatever the batch: more than the largest GPUs hold at
 /// once (an H100 holds about 3,200 of these), since workgroups that start after the batch
 /// is handed out leave at once. On an H100's random segments 4,096, 8,192 and 16,384
-/// measured within 0.7% of each other, 2,112 and 1,056 2.5% and 24% slower
-/// (docs/PERFORMANCE.md attempt 110).
+/// measured within 0.7% of each other; 2,112 and 1,056 were 2.5% and 24% slower than
+/// 4,096 (at REFILL_IDLE 32; docs/PERFORMANCE.md attempt 110).
 const REFILL_GROUPS: u32 = 8192;
 
 /// How the any-hit kernel hands rays to threads.

@@ -6,8 +6,11 @@
 // the batch at once (one atomic add per refill). With one ray per thread (any_hit), a
 // warp of random segments runs as long as its longest walk: its lanes walk 21 nodes on
 // average but the warp 58 steps (the CPU model of docs/PERFORMANCE.md attempt 110).
-// The answers are the walk's of trace_any (same functions, same order), ray for ray.
-// CPU twin: igi_core's Bvh::trace_any.
+// The answers are the walk's of trace_any (same functions, same order), ray for ray:
+// change any_hit_lanes with walk_any (tests/ray_schedules.rs compares both schedules with
+// the CPU twin, igi_core's Bvh::trace_any). The walk is written again here, not shared
+// with the gathers', whose schedule by the driver swings with trivial rewrites
+// (docs/PERFORMANCE.md attempt 90).
 //
 // Coherent batches (neighbouring rays walk alike, as the renderer's VPL-major shadow
 // rays do) trace faster with one ray per thread: refilled lanes walk apart from the
