@@ -34,22 +34,34 @@ pub enum RaySchedule {
     /// One ray per thread, in batch order (`any_hit` of rays.wgsl): best where
     /// neighbouring rays walk alike, as the renderer's VPL-major shadow rays do.
     PerThread,
-    /// Persistent subgroups that hand idle lanes the next rays (`rays_refill.wgsl`): best
-    /// for incoherent batches, whose warps otherwise wait for their longest walk. Needs
-    /// subgroup operations ([`GpuContext::subgroups`]).
+    /// Persistent subgroups whose idle lanes take the next rays (`rays_refill.wgsl`):
+    /// best for incoherent batches, whose warps otherwise wait for their longest walk.
+    /// Offered where [`refill_offered`] says.
     Refill,
+}
+
+/// Whether the refill schedule runs on this device: a GPU with subgroup operations (the
+/// ballot that says when to refill). Not on software adapters: on lavapipe (Mesa 22.3.6)
+/// the refill loop returns a few rays in ten thousand untraced (tests/ray_schedules.rs
+/// showed it, with every run's results cleared first), even with no subgroup operation
+/// in the choice of rays, while on NVIDIA's driver every ray of 16.8 M random segments,
+/// 8 M more and 60.3 M frame rays was answered as one ray per thread answers it
+/// (docs/PERFORMANCE.md attempt 110).
+pub fn refill_offered(ctx: &GpuContext) -> bool {
+    ctx.subgroups && ctx.info.device_type != wgpu::DeviceType::Cpu
 }
 
 impl RaySchedule {
     /// The schedule for a batch: [`RaySchedule::Refill`] unless most neighbouring rays in
-    /// it are alike (see [`coherent_fraction`]) or the device has no subgroup operations.
+    /// it are alike (see [`coherent_fraction`]) or the device does not offer it
+    /// ([`refill_offered`]).
     pub fn for_batch(
         ctx: &GpuContext,
         rays: &[RayRecord],
         scene_lo: Vec3,
         scene_hi: Vec3,
     ) -> RaySchedule {
-        if ctx.subgroups && coherent_fraction(rays, scene_lo, scene_hi) < 0.5 {
+        if refill_offered(ctx) && coherent_fraction(rays, scene_lo, scene_hi) < 0.5 {
             RaySchedule::Refill
         } else {
             RaySchedule::PerThread
@@ -115,7 +127,7 @@ pub struct RayBench {
     any_hit: wgpu::ComputePipeline,
     closest_hit: wgpu::ComputePipeline,
     /// The refill schedule's bindings (those of `any_hit` and the ray counter) and
-    /// pipeline; None without subgroup operations.
+    /// pipeline; None where it is not offered ([`refill_offered`]).
     refill: Option<(wgpu::BindGroupLayout, wgpu::ComputePipeline)>,
     /// Most workgroups of a refill dispatch ([`REFILL_GROUPS`]).
     refill_groups: u32,
@@ -137,7 +149,7 @@ impl RayBench {
                 usage: wgpu::BufferUsages::UNIFORM,
             },
         );
-        let refill = ctx.subgroups.then(|| {
+        let refill = refill_offered(ctx).then(|| {
             let layout = pass_layout(&ctx.device, "rays refill", &[UNIFORM, READ, WRITE, WRITE]);
             let refill = pipeline(
                 &ctx.device,
@@ -166,8 +178,10 @@ impl RayBench {
     }
 
     /// Trace `rays` [`WARMUP_RUNS`] times untimed (the GPU's clocks rise meanwhile), then
-    /// `runs` times timed; results of the last run. `schedule` applies to any hit (closest
-    /// hits always run one ray per thread); [`RaySchedule::Refill`] needs subgroups.
+    /// `runs` times timed; results of the last run (every run's results are cleared first,
+    /// so that a ray a run leaves untraced cannot keep an earlier run's answer). `schedule`
+    /// applies to any hit (closest hits always run one ray per thread);
+    /// [`RaySchedule::Refill`] only where [`refill_offered`].
     pub fn trace(
         &self,
         ctx: &GpuContext,
@@ -180,7 +194,7 @@ impl RayBench {
             (RayQuery::AnyHit, RaySchedule::Refill) => {
                 Some(self.refill.as_ref().ok_or_else(|| {
                     GpuError::Device(format!(
-                        "adapter '{}' has no subgroup operations, which the refill schedule needs",
+                        "adapter '{}' does not run the refill schedule (it needs a GPU with subgroup operations)",
                         ctx.info.name
                     ))
                 })?)
@@ -231,6 +245,9 @@ impl RayBench {
             let mut encoder = ctx.device.create_command_encoder(&Default::default());
             for counter in &counters {
                 encoder.clear_buffer(counter, 0, None);
+            }
+            for (_, output, _) in &batches {
+                encoder.clear_buffer(output, 0, None);
             }
             {
                 let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {

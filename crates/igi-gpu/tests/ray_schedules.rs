@@ -10,7 +10,7 @@ use glam::Vec3;
 use igi_core::bvh::Bvh;
 use igi_core::rays::{random_rays, random_segments, RayRecord};
 use igi_core::scene::builtin::builtin_scene;
-use igi_gpu::raybench::{coherent_fraction, RayBench, RayQuery, RaySchedule};
+use igi_gpu::raybench::{coherent_fraction, refill_offered, RayBench, RayQuery, RaySchedule};
 
 /// The Cornell box with three spheres in it (about 3,900 triangles: a tree some 12
 /// levels deep, so that walks differ in length).
@@ -43,9 +43,10 @@ fn cpu_answers(bvh: &Bvh, rays: &[RayRecord]) -> Vec<u32> {
 #[test]
 fn both_schedules_answer_like_the_cpu_twin() {
     let Some(ctx) = common::gpu() else { return };
-    if !ctx.subgroups {
+    if !refill_offered(&ctx) {
         eprintln!(
-            "skipped: adapter '{}' has no subgroup operations",
+            "skipped: adapter '{}' does not run the refill schedule (a software adapter, or \
+             no subgroup operations: raybench::refill_offered)",
             ctx.info.name
         );
         return;
@@ -114,7 +115,7 @@ fn refill_is_picked_for_incoherent_batches_only() {
         RaySchedule::for_batch(&ctx, &coherent, lo, hi),
         RaySchedule::PerThread
     );
-    let expected = if ctx.subgroups {
+    let expected = if refill_offered(&ctx) {
         RaySchedule::Refill
     } else {
         RaySchedule::PerThread

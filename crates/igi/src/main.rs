@@ -80,13 +80,14 @@ enum RaySetArg {
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
 enum ScheduleArg {
-    /// Refilled subgroups unless most neighbouring rays are alike (and the adapter has
-    /// subgroup operations); else one ray per thread.
+    /// Refilled subgroups unless most neighbouring rays are alike or the adapter does not
+    /// run them (software adapters, GPUs without subgroup operations); else one ray per
+    /// thread.
     Auto,
     /// One ray per thread, in file order: best for coherent batches.
     PerThread,
-    /// Persistent subgroups that refill idle lanes: best for incoherent batches (needs
-    /// subgroup operations).
+    /// Persistent subgroups that refill idle lanes: best for incoherent batches (needs a
+    /// GPU with subgroup operations).
     Refill,
 }
 
@@ -723,7 +724,7 @@ fn bench(args: &BenchArgs) -> Result<()> {
 
 fn bench_rays(args: &RaysArgs) -> Result<()> {
     use igi_core::rays::{random_rays, random_segments, read_rays, write_rays};
-    use igi_gpu::raybench::{coherent_fraction, RayBench, RayQuery, RaySchedule};
+    use igi_gpu::raybench::{coherent_fraction, refill_offered, RayBench, RayQuery, RaySchedule};
     if args.count == 0 {
         bail!("--count must be at least 1");
     }
@@ -748,9 +749,9 @@ fn bench_rays(args: &RaysArgs) -> Result<()> {
             ctx.info.name
         );
     }
-    if args.schedule == ScheduleArg::Refill && !ctx.subgroups {
+    if args.schedule == ScheduleArg::Refill && !refill_offered(&ctx) {
         bail!(
-            "adapter '{}' has no subgroup operations, which --schedule refill needs: use --schedule per-thread",
+            "adapter '{}' does not run --schedule refill (it needs a GPU with subgroup operations): use --schedule per-thread",
             ctx.info.name
         );
     }
@@ -804,8 +805,8 @@ fn bench_rays(args: &RaysArgs) -> Result<()> {
             let (lo, hi) = bvh.bounds();
             let alike = 100.0 * coherent_fraction(&rays, lo, hi);
             let why = match args.schedule {
-                ScheduleArg::Auto if schedule == RaySchedule::PerThread && !ctx.subgroups => {
-                    "auto: the adapter has no subgroup operations".to_string()
+                ScheduleArg::Auto if !refill_offered(&ctx) => {
+                    "auto: this adapter does not run the refill schedule".to_string()
                 }
                 ScheduleArg::Auto => format!("auto: {alike:.1}% of neighbouring rays alike"),
                 _ => format!("asked; {alike:.1}% of neighbouring rays alike"),

@@ -1,27 +1,32 @@
 // rays_refill.wgsl: the any-hit query over a ray file for incoherent batches, composed
 // after rays.wgsl (`RaySchedule::Refill` of raybench.rs). Aila and Laine's persistent
 // threads with dynamic ray fetch ("Understanding the Efficiency of Ray Traversal on
-// GPUs", 2009), with subgroup operations: a subgroup walks one node per lane and step,
-// and when enough of its lanes have finished their rays it hands them the next rays of
-// the batch at once (one atomic add per refill). With one ray per thread (any_hit), a
-// warp of random segments runs as long as its longest walk: its lanes walk 21 nodes on
-// average but the warp 58 steps (the CPU model of docs/PERFORMANCE.md attempt 110).
+// GPUs", 2009): a lane walks one node per loop iteration, and once enough lanes of its
+// subgroup have finished their rays, each idle lane takes the next ray of the batch from
+// a counter. With one ray per thread (any_hit), a warp of random segments runs as long as
+// its longest walk: its lanes walk 21 nodes on average but the warp 58 steps (the CPU
+// model of docs/PERFORMANCE.md attempt 109).
+//
+// Which ray a lane takes comes from its own atomic add: the subgroup's ballot only says
+// when to refill, so the answers never depend on how the driver keeps lanes together
+// (a leader's add for the whole subgroup, handed out by subgroupBroadcastFirst after a
+// branch, relies on the lanes meeting again after it; it measured 0.5% slower on an
+// H100, whose driver combines the lanes' adds, attempt 110).
+//
 // The answers are the walk's of trace_any (same functions, same order), ray for ray:
 // change any_hit_lanes with walk_any (tests/ray_schedules.rs compares both schedules with
 // the CPU twin, igi_core's Bvh::trace_any). The walk is written again here, not shared
-// with the gathers', whose schedule by the driver swings with trivial rewrites
-// (docs/PERFORMANCE.md attempt 90).
-//
-// Coherent batches (neighbouring rays walk alike, as the renderer's VPL-major shadow
-// rays do) trace faster with one ray per thread: refilled lanes walk apart from the
-// lanes still on their old rays (attempt 110: the frame set 6.27 -> 5.68 G rays/s).
+// with the gathers', whose schedule by the driver swings with trivial rewrites (attempt
+// 90). Coherent batches (neighbouring rays walk alike, as the renderer's VPL-major
+// shadow rays do) trace faster with one ray per thread: a refilled lane walks apart from
+// the lanes still on their old rays (the frame set 6.27 -> 5.48 G rays/s, attempt 110).
 
 // The next unassigned ray of the batch; zeroed before each dispatch.
 @group(1) @binding(3) var<storage, read_write> ray_counter: atomic<u32>;
 
-// A subgroup refills its idle lanes once at least REFILL_IDLE / 64 of its lanes are idle
-// (or all of its active ones: see any_hit_lanes). 48 (three quarters) measured best
-// among 16, 32 and 48 on an H100's random segments (attempt 110).
+// Idle lanes refill once at least REFILL_IDLE / 64 of their subgroup's lanes are idle
+// (or all of its active ones). 48 (three quarters) and 40 measured best on an H100's
+// random segments, among 1, 16, 32, 40, 48, 56 and 60 (attempt 110).
 override REFILL_IDLE: u32 = 48u;
 
 fn ballot_count(b: vec4<u32>) -> u32 {
@@ -29,11 +34,9 @@ fn ballot_count(b: vec4<u32>) -> u32 {
 }
 
 // The walk of walk_any (trace_any: no t pad, far ends scaled by BOX_TFAR_SCALE), one
-// node per iteration of a loop that also assigns rays. Correct whatever lanes the
-// driver keeps together: a refill counts and ranks only the lanes active at the ballot,
-// a subgroup whose active lanes are all idle always refills (so none waits for lanes it
-// does not see), and a lane leaves the loop on its own once the batch is exhausted.
-fn any_hit_lanes(stack: ptr<function, WalkStack>, subgroup_size: u32, lane: u32) {
+// node per iteration of a loop that also hands out rays; a lane leaves the loop once it
+// is idle and the batch is handed out.
+fn any_hit_lanes(stack: ptr<function, WalkStack>, subgroup_size: u32) {
     let ray_count = arrayLength(&rays) / 2u;
     var ray = NO_HIT;
     var more = true;
@@ -48,15 +51,10 @@ fn any_hit_lanes(stack: ptr<function, WalkStack>, subgroup_size: u32, lane: u32)
         }
         let idle_lanes = ballot_count(subgroupBallot(idle));
         let active_lanes = ballot_count(subgroupBallot(true));
-        if (more && (64u * idle_lanes >= REFILL_IDLE * subgroup_size || idle_lanes == active_lanes)) {
-            var first = 0u;
-            if (subgroupBroadcastFirst(lane) == lane) {
-                first = atomicAdd(&ray_counter, idle_lanes);
-            }
-            first = subgroupBroadcastFirst(first);
-            more = first + idle_lanes < ray_count;
-            let i = first + subgroupExclusiveAdd(select(0u, 1u, idle));
-            if (idle && i < ray_count) {
+        if (idle && (64u * idle_lanes >= REFILL_IDLE * subgroup_size || idle_lanes == active_lanes)) {
+            let i = atomicAdd(&ray_counter, 1u);
+            more = i < ray_count;
+            if (more) {
                 let a = rays[2u * i];
                 let b = rays[2u * i + 1u];
                 if (all(b.xyz == vec3<f32>(0.0))) {
@@ -110,7 +108,7 @@ fn any_hit_lanes(stack: ptr<function, WalkStack>, subgroup_size: u32, lane: u32)
 
 // Dispatched with at most REFILL_GROUPS (raybench.rs) workgroups, whatever the batch size.
 @compute @workgroup_size(64)
-fn any_hit_refill(@builtin(subgroup_size) subgroup_size: u32, @builtin(subgroup_invocation_id) lane: u32) {
+fn any_hit_refill(@builtin(subgroup_size) subgroup_size: u32) {
     var stack: WalkStack;
-    any_hit_lanes(&stack, subgroup_size, lane);
+    any_hit_lanes(&stack, subgroup_size);
 }
