@@ -52,16 +52,11 @@ pub fn refill_offered(ctx: &GpuContext) -> bool {
 }
 
 impl RaySchedule {
-    /// The schedule for a batch: [`RaySchedule::Refill`] unless most neighbouring rays in
-    /// it are alike (see [`coherent_fraction`]) or the device does not offer it
-    /// ([`refill_offered`]).
-    pub fn for_batch(
-        ctx: &GpuContext,
-        rays: &[RayRecord],
-        scene_lo: Vec3,
-        scene_hi: Vec3,
-    ) -> RaySchedule {
-        if refill_offered(ctx) && coherent_fraction(rays, scene_lo, scene_hi) < 0.5 {
+    /// The schedule for a batch whose [`coherent_fraction`] is `alike`:
+    /// [`RaySchedule::Refill`] unless most neighbouring rays in it are alike or the device
+    /// does not offer it ([`refill_offered`]).
+    pub fn auto(ctx: &GpuContext, alike: f64) -> RaySchedule {
+        if refill_offered(ctx) && alike < 0.5 {
             RaySchedule::Refill
         } else {
             RaySchedule::PerThread

@@ -793,17 +793,17 @@ fn bench_rays(args: &RaysArgs) -> Result<()> {
             write_rays(path, &rays)?;
             eprintln!("wrote {} rays to {}", rays.len(), path.display());
         }
-        let schedule = match args.schedule {
-            ScheduleArg::Auto => {
-                let (lo, hi) = bvh.bounds();
-                RaySchedule::for_batch(&ctx, &rays, lo, hi)
-            }
-            ScheduleArg::PerThread => RaySchedule::PerThread,
-            ScheduleArg::Refill => RaySchedule::Refill,
-        };
+        // Closest hits run one ray per thread whatever the schedule.
+        let mut schedule = RaySchedule::PerThread;
         if query == RayQuery::AnyHit {
             let (lo, hi) = bvh.bounds();
-            let alike = 100.0 * coherent_fraction(&rays, lo, hi);
+            let alike = coherent_fraction(&rays, lo, hi);
+            schedule = match args.schedule {
+                ScheduleArg::Auto => RaySchedule::auto(&ctx, alike),
+                ScheduleArg::PerThread => RaySchedule::PerThread,
+                ScheduleArg::Refill => RaySchedule::Refill,
+            };
+            let alike = 100.0 * alike;
             let why = match args.schedule {
                 ScheduleArg::Auto if !refill_offered(&ctx) => {
                     "auto: this adapter does not run the refill schedule".to_string()
