@@ -3,9 +3,11 @@
 //! and SAH cost, and a CPU traversal sanity figure.
 //!
 //! `cargo run --release -p igi-core --example bvh_build -- [SCENE.toml|MESH.obj] [RUNS]
-//! [--binned]` (default: the conference room of `shared/scenes`, 5 runs, the commands'
-//! default builder `BvhBuilder::Split`; `--binned` measures `BvhBuilder::Binned`). An OBJ is read as bare
-//! triangles with `tobj`, every face kept (the scene loader may drop degenerate ones).
+//! [--binned] [--build-only]` (default: the conference room of `shared/scenes`, 5 runs,
+//! the commands' default builder `BvhBuilder::Split`; `--binned` measures
+//! `BvhBuilder::Binned`; `--build-only` skips the traversal figures, for profilers). An
+//! OBJ is read as bare triangles with `tobj`, every face kept (the scene loader may drop
+//! degenerate ones).
 
 use std::io::Write;
 use std::path::PathBuf;
@@ -31,7 +33,10 @@ fn main() {
     } else {
         BvhBuilder::Split
     };
-    let mut args = std::env::args().skip(1).filter(|a| a != "--binned");
+    let build_only = std::env::args().any(|a| a == "--build-only");
+    let mut args = std::env::args()
+        .skip(1)
+        .filter(|a| a != "--binned" && a != "--build-only");
     let path = PathBuf::from(
         args.next()
             .unwrap_or_else(|| "/work/shared/scenes/conference/scene.toml".to_string()),
@@ -67,12 +72,19 @@ fn main() {
     );
 
     let mut times = vec![];
+    let mut phases: Vec<(&str, Vec<f64>)> = vec![];
     let mut bvh = None;
     let cpu_start = process_cpu_seconds();
     for _ in 0..runs {
         let t = Instant::now();
         let b = Bvh::build_with(&triangles, builder);
         times.push(t.elapsed().as_secs_f64() * 1e3);
+        for (k, &(name, ms)) in b.build_stats.phases.iter().enumerate() {
+            if k == phases.len() {
+                phases.push((name, vec![]));
+            }
+            phases[k].1.push(ms);
+        }
         bvh = Some(b);
     }
     let cpu = process_cpu_seconds()
@@ -91,6 +103,24 @@ fn main() {
         times[0],
         times[runs - 1]
     );
+    let medians: Vec<String> = phases
+        .iter_mut()
+        .map(|(name, ms)| {
+            ms.sort_by(f64::total_cmp);
+            format!("{name} {:.1}", ms[ms.len() / 2])
+        })
+        .collect();
+    out!("phases, median ms: {}", medians.join(", "));
+    // Equal hashes: the same tree, for checking that a change to the builder keeps it.
+    let mut hash = 0xcbf2_9ce4_8422_2325u64;
+    for byte in bytemuck::cast_slice::<_, u8>(&bvh.nodes)
+        .iter()
+        .chain(bytemuck::cast_slice::<_, u8>(&bvh.tri_rows))
+        .chain(bytemuck::cast_slice::<_, u8>(&bvh.tri_order))
+    {
+        hash = (hash ^ *byte as u64).wrapping_mul(0x100_0000_01b3);
+    }
+    out!("tree hash (FNV-1a of nodes, rows and slot order): {hash:016x}");
     out!(
         "references {}, nodes {} ({} KiB), leaves {}, max depth {}, max leaf {}, oversized leaves {}, SAH cost {:.2}",
         s.references,
@@ -104,7 +134,7 @@ fn main() {
     );
 
     // Primary rays of the scene's camera, on one core: a rough figure for the CPU twin.
-    let Some(scene) = scene else {
+    let Some(scene) = scene.filter(|_| !build_only) else {
         return;
     };
     let cam = scene.camera;

@@ -222,6 +222,9 @@ pub struct BuildStats {
     /// SAH cost of the tree, relative to the root box's surface area:
     /// sum over interior nodes of C_t A(n)/A(root) + sum over leaves of C_i N A(l)/A(root).
     pub sah_cost: f32,
+    /// Wall time of the build's phases in milliseconds, in order: the references (and
+    /// their split clipping), the tree, the layout.
+    pub phases: Vec<(&'static str, f64)>,
 }
 
 /// Vertices 0, 1 and 2 of BVH slot `slot` of [`Bvh::tri_rows`].

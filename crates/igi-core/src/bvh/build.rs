@@ -12,15 +12,16 @@
 //!
 //! Primitives are 32-byte boxes (`PrimRef`) partitioned in place, with their triangle
 //! indices in a parallel array, so that each level is two sequential passes over memory.
-//! The two subtrees of the top levels are built on separate threads (`std::thread::scope`);
-//! each thread writes its own node list, appended and re-indexed after the join, so nodes
-//! stay in depth-first order (left subtree before right, children after their parent)
-//! whatever the thread count: the result does not depend on the machine. Each node makes
+//! The two subtrees of every range of at least `PARALLEL_MIN_PRIMS` triangles are built
+//! as two tasks of rayon's work-stealing pool (`rayon_core::join`), each in a region of
+//! the node array of its own sized by its triangle count (`Region`), so that the tree
+//! does not depend on which thread built what, nor on the machine. Each node makes
 //! Kensler's tree rotations as soon as its subtree is built ([`rotate_locally`]), which
-//! lowers the SAH cost where the greedy splits left room; then the nodes are laid out
-//! depth first again (each node's two subtrees right after it, one after the other), and
-//! child a, which any-hit walks visit first, becomes the one likelier to stop them per
-//! unit of work ([`occluder_first`]); it need not be the left one.
+//! lowers the SAH cost where the greedy splits left room, and keeps what the layout
+//! needs (`NodeInfo`); then the nodes are laid out depth first again (each node's two
+//! subtrees right after it, one after the other), and child a, which any-hit walks visit
+//! first, becomes the one likelier to stop them per unit of work ([`occluder_first`]);
+//! it need not be the left one. [`BuildStats::phases`] times the steps.
 //!
 //! With [`super::BvhBuilder::Split`] the references are not whole triangles but the
 //! pieces that early split clipping (`split`) cut the wasteful ones into; the build is
@@ -36,8 +37,10 @@ use super::{
 };
 use crate::scene::Triangle;
 
-/// Ranges smaller than this are not worth a thread.
-const PARALLEL_MIN_PRIMS: usize = 16 * 1024;
+/// Ranges smaller than this are not worth a task of their own: on the conference room
+/// and the 2-core machine, 4,096 and 16,384 measured alike (docs/PERFORMANCE.md attempt
+/// 111).
+const PARALLEL_MIN_PRIMS: usize = 4 * 1024;
 
 /// Ranges up to this size are split by an exact SAH sweep over their sorted centroids
 /// instead of bins: most nodes of a tree are small, and for them the fixed cost of
@@ -91,7 +94,8 @@ impl Aabb {
 
 /// Bounds of one triangle. Its centroid, doubled, is `lo + hi` (the factor 2 is the same
 /// for every primitive, so bins and splits do not care).
-#[derive(Clone, Copy, Debug)]
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 pub(super) struct PrimRef {
     pub(super) lo: Vec3A,
     pub(super) hi: Vec3A,
@@ -120,8 +124,8 @@ struct Task<'a> {
 struct Limits {
     /// Ranges at this depth become leaves ([`MAX_DEPTH`] outside tests).
     max_depth: u32,
-    /// Levels whose two subtrees are built on separate threads.
-    par_levels: u32,
+    /// Whether the two subtrees of large ranges are built side by side (work stealing).
+    parallel: bool,
     /// Rotations each node may make on the way up ([`rotate_locally`]; 0: none).
     rotation_budget: u32,
     /// Early split clipping of the references (`split`).
@@ -129,11 +133,10 @@ struct Limits {
 }
 
 impl Limits {
-    /// Subtrees on separate threads down to the level with about two per thread.
     fn new(max_depth: u32, rotation_budget: u32) -> Limits {
         Limits {
             max_depth,
-            par_levels: threads().next_power_of_two().trailing_zeros() + 1,
+            parallel: threads() > 1,
             rotation_budget,
             split: false,
         }
@@ -235,7 +238,7 @@ where
 #[cfg(test)]
 pub(super) fn build_on_one_thread(triangles: &[[Vec3; 3]]) -> Bvh {
     let limits = Limits {
-        par_levels: 0,
+        parallel: false,
         ..Limits::new(MAX_DEPTH, ROTATION_BUDGET)
     };
     build_impl(triangles.len(), |i| triangles[i], limits)
@@ -266,39 +269,67 @@ pub(super) fn build_with_rotations(triangles: &[[Vec3; 3]], max_depth: u32, budg
     )
 }
 
+/// Threads of the work-stealing pool the build runs on (rayon's global pool: one per core).
 fn threads() -> usize {
-    std::thread::available_parallelism()
-        .map(|n| n.get())
-        .unwrap_or(1)
-        .clamp(1, 64)
+    rayon_core::current_num_threads()
 }
 
-/// Runs `f(chunk_start, chunk)` over `data` split into one chunk per thread, each chunk a
-/// multiple of `align` long; returns the results in chunk order.
+/// Runs `f(chunk_start, chunk)` over `data` split into chunks, each a multiple of `align`
+/// long, on all threads; returns the results in chunk order. Four chunks per thread,
+/// taken by whichever thread is free, so that uneven work (the few triangles that split
+/// clipping cuts) does not wait for one thread.
 pub(super) fn par_chunks<T: Send, R: Send, F>(data: &mut [T], align: usize, f: F) -> Vec<R>
 where
     F: Fn(usize, &mut [T]) -> R + Sync,
 {
-    let n = data.len();
-    let t = threads();
-    if t == 1 || n < 4096 {
+    let Some(chunk) = chunk_len(data.len(), align) else {
         return vec![f(0, data)];
-    }
-    let chunk = n.div_ceil(t).next_multiple_of(align);
-    std::thread::scope(|s| {
-        let handles: Vec<_> = data
-            .chunks_mut(chunk)
-            .enumerate()
-            .map(|(k, c)| {
-                let f = &f;
-                s.spawn(move || f(k * chunk, c))
-            })
-            .collect();
-        handles
-            .into_iter()
-            .map(|h| h.join().expect("BVH build thread panicked"))
-            .collect()
-    })
+    };
+    let mut results: Vec<Option<R>> = data.chunks(chunk).map(|_| None).collect();
+    let f = &f;
+    rayon_core::scope(|s| {
+        for (k, (c, r)) in data.chunks_mut(chunk).zip(&mut results).enumerate() {
+            s.spawn(move |_| *r = Some(f(k * chunk, c)));
+        }
+    });
+    results
+        .into_iter()
+        .map(|r| r.expect("every chunk ran"))
+        .collect()
+}
+
+/// A vector of `n` items (with room for `spare` more) made on all threads: item i is
+/// `item(i)`, and `reduce` runs over each chunk once it is written (its results come
+/// in chunk order). The threads write the memory once: zeroed first, as `vec!` does, it
+/// would be written twice, the first time in one thread when the allocator reuses
+/// memory (docs/PERFORMANCE.md attempt 111).
+fn par_vec<T, R, I, G>(n: usize, spare: usize, item: I, reduce: G) -> (Vec<T>, Vec<R>)
+where
+    T: Send + Sync,
+    R: Send,
+    I: Fn(usize) -> T + Sync,
+    G: Fn(&[T]) -> R + Sync,
+{
+    let mut v: Vec<T> = Vec::with_capacity(n + spare);
+    let results = par_chunks(&mut v.spare_capacity_mut()[..n], 1, |base, chunk| {
+        for (k, slot) in chunk.iter_mut().enumerate() {
+            slot.write(item(base + k));
+        }
+        // SAFETY: every element of the chunk was initialised just above, and
+        // MaybeUninit<T> has the layout of T.
+        let done = unsafe { &*(chunk as *const [std::mem::MaybeUninit<T>] as *const [T]) };
+        reduce(done)
+    });
+    // SAFETY: par_chunks ran the closure above over every chunk of the first n elements
+    // (a panic in it would have ended this function), and it initialised each of them.
+    unsafe { v.set_len(n) };
+    (v, results)
+}
+
+/// The chunk length of [`par_chunks`] for `n` items, or None where one thread does it all.
+fn chunk_len(n: usize, align: usize) -> Option<usize> {
+    let t = threads();
+    (t > 1 && n >= 4096).then(|| n.div_ceil(4 * t).next_multiple_of(align))
 }
 
 /// Counts and areas gathered while building, for [`BuildStats`].
@@ -332,6 +363,7 @@ where
     F: Fn(usize) -> [Vec3; 3] + Sync,
 {
     let start = Instant::now();
+    let mut phases = Phases::new(start);
     // The GPU indexes tri_rows with 3 * slot + 2 in u32.
     assert!(
         count <= (u32::MAX / 3) as usize,
@@ -346,10 +378,17 @@ where
         };
     }
 
-    let (mut prims, bounds, mut cbounds) = whole_references(count, &tri);
-    let mut ids: Vec<u32> = (0..count as u32).collect();
+    // Early split clipping appends pieces: room for as many again as there are
+    // triangles, which costs nothing until written, so that the references are not
+    // copied to a larger vector (more pieces than that still fit, after one copy).
+    let spare = if limits.split { count } else { 0 };
+    let (mut prims, bounds, mut cbounds, tri_area) = whole_references(count, &tri, spare);
+    let mut ids: Vec<u32> = Vec::with_capacity(count + spare);
+    ids.extend(0..count as u32);
+    phases.lap("references");
     if limits.split {
         cbounds = super::split::split_references(&mut prims, &mut ids, &bounds, &tri);
+        phases.lap("split clipping");
     }
     // References: one per triangle, or more with early split clipping.
     let refs = prims.len();
@@ -361,8 +400,10 @@ where
     // Room for refs - 1 interior nodes, the most a tree over refs references has; zeroed
     // by the allocator, so that the places no subtree writes (see Region) are never
     // touched.
-    let mut nodes: Vec<BvhNode> = bytemuck::zeroed_vec(refs.max(2) - 1);
-    let mut heights = vec![0u8; nodes.len()];
+    let places = refs.max(2) - 1;
+    let mut nodes: Vec<BvhNode> = bytemuck::zeroed_vec(places);
+    let mut info: Vec<NodeInfo> = bytemuck::zeroed_vec(places);
+    let mut slot_area = vec![0.0f32; refs];
     let mut tally = Tally::default();
     let root = build_node(
         Task {
@@ -375,40 +416,49 @@ where
         },
         &mut Region {
             nodes: &mut nodes,
-            heights: &mut heights,
+            info: &mut info,
             base: 0,
             used: 0,
+            slot_area: &mut slot_area,
+            slot_base: 0,
         },
         &mut tally,
         &limits,
-    )
-    .0;
-    drop(heights);
+        &tri_area,
+    );
+    drop((prims, slot_area, tri_area));
     if root.count > 0 {
         // A root that is a leaf still needs an interior node 0 to hold its box; the leaf
-        // is its child, at depth 1.
+        // is its child, at depth 1, and stays child a.
         nodes[0] = BvhNode::new(bounds.child(root.index, root.count), BvhChild::EMPTY);
+        info[0] = NodeInfo {
+            interior: 1,
+            ..NodeInfo::default()
+        };
     }
-    drop(prims);
+    phases.lap("tree");
 
-    // Per slot the x, y and z rows of its vertices (see Bvh::tri_rows).
-    let mut tri_rows = vec![[0.0f32; 4]; 3 * refs];
-    par_chunks(&mut tri_rows, 3, |base, chunk| {
-        for (k, out) in chunk.chunks_exact_mut(3).enumerate() {
-            let [v0, v1, v2] = tri(ids[base / 3 + k] as usize);
-            for (axis, o) in out.iter_mut().enumerate() {
-                *o = [v0[axis], v1[axis], v2[axis], 0.0];
-            }
-        }
-    });
+    // Per slot the x, y and z rows of its vertices (see Bvh::tri_rows). In a pass of its
+    // own rather than at the leaves: the reads of scattered triangles overlap here, and
+    // the leaves took twice as long over them (docs/PERFORMANCE.md attempt 111).
+    let (rows, _) = par_vec(
+        refs,
+        0,
+        |slot| {
+            let [v0, v1, v2] = tri(ids[slot] as usize);
+            [0, 1, 2].map(|axis| [v0[axis], v1[axis], v2[axis], 0.0])
+        },
+        |_| (),
+    );
+    let tri_rows: Vec<[f32; 4]> = bytemuck::allocation::cast_vec(rows);
+    phases.lap("rows");
 
     // Rotations and larger_first moved subtrees around: each node's subtrees right after it
-    // again; then child a the likelier occluder (occluder_first).
-    // A binary tree of n leaves has n - 1 interior nodes (a root leaf still needs node 0).
-    let interior = tally.leaves.max(2) - 1;
-    let (mut nodes, interior_area, deepest) = depth_first_layout(&nodes, interior);
-    occluder_first(&mut nodes, &tri_rows);
-    let build_stats = stats(
+    // again, with child a the likelier occluder (occluder_first).
+    let (nodes, interior_area, deepest) = depth_first_layout(&nodes, &info);
+    drop(info);
+    phases.lap("layout");
+    let mut build_stats = stats(
         count,
         refs,
         nodes.len(),
@@ -417,6 +467,7 @@ where
         bounds.half_area(),
         start,
     );
+    build_stats.phases = phases.done();
     Bvh {
         nodes,
         tri_rows,
@@ -425,60 +476,127 @@ where
     }
 }
 
-/// One reference per triangle, its box: (boxes, box of all, box of the doubled centroids).
-pub(super) fn whole_references<F>(count: usize, tri: &F) -> (Vec<PrimRef>, Aabb, Aabb)
+/// Wall time of the build's phases, for [`BuildStats::phases`].
+struct Phases {
+    last: Instant,
+    done: Vec<(&'static str, f64)>,
+}
+
+impl Phases {
+    fn new(start: Instant) -> Phases {
+        Phases {
+            last: start,
+            done: vec![],
+        }
+    }
+
+    /// Ends the phase `name`.
+    fn lap(&mut self, name: &'static str) {
+        let now = Instant::now();
+        self.done
+            .push((name, (now - self.last).as_secs_f64() * 1e3));
+        self.last = now;
+    }
+
+    fn done(self) -> Vec<(&'static str, f64)> {
+        self.done
+    }
+}
+
+/// One reference per triangle, its box: (boxes, box of all, box of the doubled centroids,
+/// area of each triangle), the boxes' vector with room for `spare` more. A triangle
+/// with a non-finite vertex has area 0 (see [`occluder_first`]).
+pub(super) fn whole_references<F>(
+    count: usize,
+    tri: &F,
+    spare: usize,
+) -> (Vec<PrimRef>, Aabb, Aabb, Vec<f32>)
 where
     F: Fn(usize) -> [Vec3; 3] + Sync,
 {
-    let mut prims = vec![
-        PrimRef {
-            lo: Vec3A::ZERO,
-            hi: Vec3A::ZERO
-        };
-        count
-    ];
-    let chunk_bounds = par_chunks(&mut prims, 1, |base, chunk| {
-        for (k, p) in chunk.iter_mut().enumerate() {
-            let [a, b, c] = tri(base + k).map(Vec3A::from);
+    let (prims, chunk_bounds) = par_vec(
+        count,
+        spare,
+        |i| {
+            let [a, b, c] = tri(i).map(Vec3A::from);
             let (lo, hi) = (a.min(b).min(c), a.max(b).max(c));
             // A triangle with a non-finite vertex is never hit (the triangle test fails
             // on it); a point box keeps it out of everyone's way and keeps centroids
             // comparable (no NaN), which the sort of SmallSweep relies on.
-            *p = if lo.is_finite() && hi.is_finite() {
+            if lo.is_finite() && hi.is_finite() {
                 PrimRef { lo, hi }
             } else {
                 PrimRef {
                     lo: Vec3A::ZERO,
                     hi: Vec3A::ZERO,
                 }
-            };
-        }
-        range_bounds(chunk)
-    });
+            }
+        },
+        range_bounds,
+    );
+    let (areas, _) = par_vec(
+        count,
+        0,
+        |i| {
+            let [a, b, c] = tri(i).map(Vec3A::from);
+            let area = 0.5 * (b - a).cross(c - a).length();
+            if area.is_finite() {
+                area
+            } else {
+                0.0
+            }
+        },
+        |_| (),
+    );
     let (mut bounds, mut cbounds) = (Aabb::EMPTY, Aabb::EMPTY);
     for (b, c) in chunk_bounds {
         bounds.grow(&b);
         cbounds.grow(&c);
     }
-    (prims, bounds, cbounds)
+    (prims, bounds, cbounds, areas)
 }
 
 /// Rotations a node may make on the way up of the build (see [`rotate_locally`]).
 const ROTATION_BUDGET: u32 = 8;
 
-/// The part of the tree's node array (and of the nodes' heights) that a subtree writes:
-/// nodes at global indices `base ..`, `used` of them so far. A subtree of n triangles
-/// gets n - 1 places, the most it can need; one built on another thread gets a region
-/// of its own, carved from its parent's, so that the two sides of a split are built in
-/// place side by side. The places a subtree leaves unused stay zero and unreachable, and
-/// the depth-first layout drops them. (The right subtree used to be built in a vector
-/// of its own and copied behind the left one: 6 ms of copies, mostly after joins, on the
-/// conference room; docs/PERFORMANCE.md attempt 63.)
+/// What the build keeps per interior node besides the node itself: its height for the
+/// rotations' depth cap ([`rotate_locally`]), and what [`occluder_first`] orders its
+/// children by, so that the layout can place them without a pass of its own.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, bytemuck::Pod, bytemuck::Zeroable)]
+struct NodeInfo {
+    /// Triangle area below the node (see [`occluder_first`]).
+    area: f32,
+    /// SAH cost of the interior nodes below the node and of the node itself, not divided
+    /// by any area (see [`occluder_first`]).
+    cost: f32,
+    /// Interior nodes in the node's subtree, itself included (where the layout puts its
+    /// second subtree).
+    interior: u32,
+    /// Levels below the node: 1 for a node whose children are leaves.
+    height: u8,
+    /// 1 where child b is the likelier occluder and the layout makes it child a.
+    swap: u8,
+    _pad: [u8; 2],
+}
+
+/// The part of the tree's node array (and of the nodes' [`NodeInfo`]) that a subtree
+/// writes: nodes at global indices `base ..`, `used` of them so far; with the triangle
+/// areas of the BVH slots from `slot_base` on, which its leaves write. A subtree
+/// of n triangles gets n - 1 places, the most it can need; one built on another thread
+/// gets a region of its own, carved from its parent's, so that the two sides of a split
+/// are built in place side by side. The places a subtree leaves unused stay zero and
+/// unreachable, and the depth-first layout drops them. (The right subtree used to be
+/// built in a vector of its own and copied behind the left one: 6 ms of copies, mostly
+/// after joins, on the conference room; docs/PERFORMANCE.md attempt 63.)
 struct Region<'a> {
     nodes: &'a mut [BvhNode],
-    heights: &'a mut [u8],
+    info: &'a mut [NodeInfo],
     base: usize,
     used: usize,
+    /// Per slot the area of its triangle (0 for a non-finite one).
+    slot_area: &'a mut [f32],
+    slot_base: usize,
 }
 
 impl Region<'_> {
@@ -492,38 +610,99 @@ impl Region<'_> {
         self.nodes[i - self.base]
     }
 
-    fn set(&mut self, i: usize, node: BvhNode, height: u8) {
+    fn info(&self, i: usize) -> &NodeInfo {
+        &self.info[i - self.base]
+    }
+
+    /// Stores node `i`, whose children are final, with its [`NodeInfo`].
+    fn set(&mut self, i: usize, node: BvhNode) {
+        let (a, b) = (node.a(), node.b());
+        let ((area_a, cost_a), (area_b, cost_b)) = (self.content(&a), self.content(&b));
+        let visit = SAH_TRAVERSAL_COST * union(&a, &b).half_area();
+        // The sums are taken in the final order of the children.
+        let swap = occluder_first((area_a, cost_a), (area_b, cost_b));
+        let (area, cost) = if swap {
+            (area_b + area_a, visit + cost_b + cost_a)
+        } else {
+            (area_a + area_b, visit + cost_a + cost_b)
+        };
         self.nodes[i - self.base] = node;
-        self.heights[i - self.base] = height;
+        self.info[i - self.base] = NodeInfo {
+            area,
+            cost,
+            interior: 1 + self.interior(&a) + self.interior(&b),
+            height: 1 + self.height(&a).max(self.height(&b)),
+            swap: u8::from(swap),
+            _pad: [0; 2],
+        };
     }
 
     /// Levels below a child: 0 for a leaf, its node's height for an interior node.
     fn height(&self, c: &BvhChild) -> u8 {
         if is_node(c) {
-            self.heights[c.index as usize - self.base]
+            self.info(c.index as usize).height
         } else {
             0
         }
     }
 
+    /// Interior nodes of a child's subtree (0 for a leaf).
+    fn interior(&self, c: &BvhChild) -> u32 {
+        if is_node(c) {
+            self.info(c.index as usize).interior
+        } else {
+            0
+        }
+    }
+
+    /// The triangle area and the interior nodes' SAH cost below a child (see
+    /// [`occluder_first`]); a leaf's area summed slot by slot.
+    fn content(&self, c: &BvhChild) -> (f32, f32) {
+        if is_node(c) {
+            let info = self.info(c.index as usize);
+            (info.area, info.cost)
+        } else if c.is_empty() {
+            (0.0, 0.0)
+        } else {
+            let first = c.index as usize - self.slot_base;
+            let area = self.slot_area[first..first + c.count as usize].iter().sum();
+            (area, 0.0)
+        }
+    }
+
+    /// Writes the triangle areas of the leaf of `ids`, whose first slot is `first`.
+    fn write_leaf(&mut self, first: u32, ids: &[u32], tri_area: &[f32]) {
+        let first = first as usize - self.slot_base;
+        for (area, &id) in self.slot_area[first..first + ids.len()].iter_mut().zip(ids) {
+            *area = tri_area[id as usize];
+        }
+    }
+
     /// The rest of the region split for a node's two subtrees built side by side: the
-    /// left one (k triangles) gets k - 1 places, the right one the rest.
-    fn split(&mut self, k: usize) -> (Region<'_>, Region<'_>) {
+    /// left one (k triangles from slot `first`) gets k - 1 places, the right one the
+    /// rest; the slots split after the left one's.
+    fn split(&mut self, k: usize, first: u32) -> (Region<'_>, Region<'_>) {
         let (ln, rn) = self.nodes[self.used..].split_at_mut(k - 1);
-        let (lh, rh) = self.heights[self.used..].split_at_mut(k - 1);
+        let (li, ri) = self.info[self.used..].split_at_mut(k - 1);
+        let at = first as usize + k - self.slot_base;
+        let (la, ra) = self.slot_area.split_at_mut(at);
         let base = self.base + self.used;
         (
             Region {
                 nodes: ln,
-                heights: lh,
+                info: li,
                 base,
                 used: 0,
+                slot_area: la,
+                slot_base: self.slot_base,
             },
             Region {
                 nodes: rn,
-                heights: rh,
+                info: ri,
                 base: base + k - 1,
                 used: 0,
+                slot_area: ra,
+                slot_base: self.slot_base + at,
             },
         )
     }
@@ -557,9 +736,8 @@ fn rotate_locally(tree: &mut Region, i: usize, depth: u32, max_depth: u32, budge
         };
         *budget -= 1;
         rotate_locally(tree, y, depth + 1, max_depth, budget);
-        let n = tree.node(i);
-        let h = 1 + tree.height(&n.a()).max(tree.height(&n.b()));
-        tree.set(i, n, h);
+        // y's subtree may have changed again: i's info anew.
+        tree.set(i, tree.node(i));
     }
 }
 
@@ -569,8 +747,8 @@ fn rotate_node(tree: &mut Region, i: usize, depth: u32, max_depth: u32) -> Optio
     let n = tree.node(i);
     let kids = [n.a(), n.b()];
     let h = |c: &BvhChild| tree.height(c);
-    // (area saved, the side of x, the grandchild that moves up, the new heights of y and i)
-    let mut best: Option<(f32, usize, usize, u8, u8)> = None;
+    // (area saved, the side of x, the grandchild that moves up)
+    let mut best: Option<(f32, usize, usize)> = None;
     for side in 0..2 {
         let (x, y) = (kids[side], kids[1 - side]);
         if !is_node(&y) {
@@ -587,25 +765,25 @@ fn rotate_node(tree: &mut Region, i: usize, depth: u32, max_depth: u32) -> Optio
                 && depth + i_height as u32 <= max_depth
                 && best.is_none_or(|b| saved > b.0)
             {
-                best = Some((saved, side, k, y_height, i_height));
+                best = Some((saved, side, k));
             }
         }
     }
-    let (_, side, k, y_height, i_height) = best?;
+    let (_, side, k) = best?;
     let (x, y) = (kids[side], kids[1 - side]);
     let grand = tree.node(y.index as usize);
     let g = [grand.a(), grand.b()];
     let (up, stays) = (g[k], g[1 - k]);
-    tree.set(y.index as usize, larger_first(x, stays), y_height);
+    tree.set(y.index as usize, larger_first(x, stays));
     let y = union(&x, &stays).child(y.index, 0);
-    tree.set(i, larger_first(up, y), i_height);
+    tree.set(i, larger_first(up, y));
     Some(y.index as usize)
 }
 
-/// Makes child a of every node the child likelier to stop an any-hit walk per unit of
-/// work: the one with the larger ratio of the triangle area below it to the interior
-/// nodes' SAH cost below it (ties keep the order), in a tree laid out depth first
-/// (children after their parents, which one pass from the last node to the first needs).
+/// Whether child b of a node, not child a, is the child likelier to stop an any-hit walk
+/// per unit of work, given each child's (triangle area, interior nodes' SAH cost) below
+/// it: the one with the larger ratio of the two (ties keep the order). The build keeps
+/// these sums per node ([`NodeInfo`]) and the layout makes the likelier child child a.
 /// Any-hit walks visit child a first. When a segment enters both children, visiting A
 /// first costs C_A + (1 - p_A) C_B, where p is the chance of an occluder in the child and
 /// C the expected work there; A goes first when p_A / C_A > p_B / C_B. Given that the
@@ -625,85 +803,101 @@ fn rotate_node(tree: &mut Region, i: usize, depth: u32, max_depth: u32) -> Optio
 /// are swapped, child b's subtree is the one right after the node: laying the tree out
 /// again so that child a's came first measured the same on the H200 (attempt 80) and cost
 /// the build 4-8 ms.
-fn occluder_first(nodes: &mut [BvhNode], tri_rows: &[[f32; 4]]) {
-    let mut slot_area = vec![0.0f32; tri_rows.len() / 3];
-    par_chunks(&mut slot_area, 1, |base, chunk| {
-        for (k, out) in chunk.iter_mut().enumerate() {
-            let [v0, v1, v2] = super::rows_to_vertices(tri_rows, base + k).map(Vec3A::from);
-            let a = 0.5 * (v1 - v0).cross(v2 - v0).length();
-            *out = if a.is_finite() { a } else { 0.0 };
-        }
-    });
-    // Per node: the triangle area and the interior nodes' SAH cost (not divided by any
-    // area) below it.
-    let mut below = vec![(0.0f32, 0.0f32); nodes.len()];
-    for i in (0..nodes.len()).rev() {
-        let n = nodes[i];
-        let content = |c: &BvhChild| -> (f32, f32) {
-            if is_node(c) {
-                debug_assert!(c.index as usize > i, "not laid out depth first");
-                below[c.index as usize]
-            } else if c.is_empty() {
-                (0.0, 0.0) // the empty child of a root leaf
-            } else {
-                let slots = c.index as usize..(c.index + c.count) as usize;
-                (slot_area[slots].iter().sum(), 0.0)
-            }
-        };
-        let ((area_a, cost_a), (area_b, cost_b)) = (content(&n.a()), content(&n.b()));
-        let visit = SAH_TRAVERSAL_COST * union(&n.a(), &n.b()).half_area();
-        // area_b / cost_b > area_a / cost_a without dividing (two leaves, or a leaf and the
-        // empty child: 0 > 0).
-        // The sums are taken in the final order of the children.
-        below[i] = if area_b * cost_a > area_a * cost_b {
-            nodes[i] = BvhNode::new(n.b(), n.a());
-            (area_b + area_a, visit + cost_b + cost_a)
-        } else {
-            (area_a + area_b, visit + cost_a + cost_b)
-        };
-    }
+fn occluder_first((area_a, cost_a): (f32, f32), (area_b, cost_b): (f32, f32)) -> bool {
+    // area_b / cost_b > area_a / cost_a without dividing (two leaves, or a leaf and the
+    // empty child: 0 > 0).
+    area_b * cost_a > area_a * cost_b
 }
 
-/// The tree renumbered depth first, child a's subtree right after its parent, then child
-/// b's (before [`occluder_first`] picks child a); with the sum of the interior nodes' half
-/// areas below the root and the deepest leaf's depth (the root has depth 0), for the
-/// SAH cost (`interior`: the tree's interior node count, for the output's capacity).
-/// One walk that writes each node at its new index and patches its parent's
-/// reference to it: on the conference room, 3.9-4.5 ms of the 2-core machine, against
-/// 9.3-10.7 ms for the three passes it replaced (list the order, renumber, sum).
-fn depth_first_layout(nodes: &[BvhNode], interior: usize) -> (Vec<BvhNode>, f64, u32) {
-    let mut out: Vec<BvhNode> = Vec::with_capacity(interior);
-    let (mut interior_area, mut deepest) = (0.0f64, 0u32);
-    // (node, its parent's new index and side (0: a, 1: b), its depth); the root has no parent.
-    let mut stack = vec![(0u32, u32::MAX, 0u8, 0u32)];
-    while let Some((i, parent, side, depth)) = stack.pop() {
-        let k = out.len() as u32;
-        if parent != u32::MAX {
-            let p = &mut out[parent as usize];
-            if side == 0 {
-                p.a_index = k;
-            } else {
-                p.b_index = k;
-            }
-        }
+/// Levels of the layout's top whose two subtrees are laid out side by side (4 parts: a
+/// fixed number, so that the sums of the statistics, taken part by part, do not depend
+/// on the machine).
+const LAYOUT_SPLIT_LEVELS: u32 = 2;
+
+/// The tree renumbered depth first: each node's subtrees right after it, the subtree of
+/// its child a as the build left it first (after the larger_first order of the
+/// rotations), then the other; with child a the likelier occluder (`NodeInfo::swap`,
+/// [`occluder_first`]), which may make child b's subtree the one right after the node.
+/// Returns the sum of the interior nodes' half areas below the root and the deepest
+/// leaf's depth (the root has depth 0), for the SAH cost. The subtree sizes in
+/// [`NodeInfo`] place every node at once, so the top subtrees are laid out on separate
+/// threads: on the conference room the one walk it replaced took 3.9-10 ms of the 2-core
+/// machine, and the ordering pass after it 7.5-9 ms (docs/PERFORMANCE.md attempt 111).
+fn depth_first_layout(nodes: &[BvhNode], info: &[NodeInfo]) -> (Vec<BvhNode>, f64, u32) {
+    let mut out: Vec<BvhNode> = bytemuck::zeroed_vec(info[0].interior as usize);
+    let (area, deepest) = lay_out(nodes, info, 0, &mut out, 0, 0);
+    (out, area, deepest)
+}
+
+/// Lays out the subtree of node `root` (at `depth`) into `out`, whose first place has the
+/// global index `at`; returns its statistics (see [`depth_first_layout`]).
+fn lay_out(
+    nodes: &[BvhNode],
+    info: &[NodeInfo],
+    root: u32,
+    out: &mut [BvhNode],
+    at: u32,
+    depth: u32,
+) -> (f64, u32) {
+    let (mut area, mut deepest) = (0.0f64, 0u32);
+    // The node at its new place, and where its children's subtrees go.
+    let mut place = |i: u32, k: u32, depth: u32, out: &mut [BvhNode]| {
         let n = nodes[i as usize];
-        out.push(n);
-        // Areas in child order, node by node in the new order (the order the stats of
-        // earlier builds summed in); b pushed first so that a's subtree comes next.
-        for c in [n.a(), n.b()] {
+        let (a, b) = (n.a(), n.b());
+        let interior = |c: &BvhChild| {
+            if is_node(c) {
+                info[c.index as usize].interior
+            } else {
+                0
+            }
+        };
+        let (ka, kb) = (k + 1, k + 1 + interior(&a));
+        // Areas in child order, node by node in the new order.
+        for c in [a, b] {
             if is_node(&c) {
-                interior_area += c.half_area() as f64;
+                area += c.half_area() as f64;
             } else if c.min.x <= c.max.x {
                 deepest = deepest.max(depth + 1);
             }
         }
-        for (side, c) in [(1u8, n.b()), (0u8, n.a())] {
+        let mut m = n;
+        if is_node(&a) {
+            m.a_index = ka;
+        }
+        if is_node(&b) {
+            m.b_index = kb;
+        }
+        if info[i as usize].swap != 0 {
+            m = BvhNode::new(m.b(), m.a());
+        }
+        out[(k - at) as usize] = m;
+        [(a, ka), (b, kb)]
+    };
+    if depth < LAYOUT_SPLIT_LEVELS {
+        let [(a, ka), (b, kb)] = place(root, at, depth, out);
+        let (_, rest) = out.split_at_mut(1);
+        let (out_a, out_b) = rest.split_at_mut((kb - ka) as usize);
+        let part = |c: BvhChild, k: u32, out: &mut [BvhNode]| {
             if is_node(&c) {
-                stack.push((c.index, k, side, depth + 1));
+                lay_out(nodes, info, c.index, out, k, depth + 1)
+            } else {
+                (0.0, 0)
+            }
+        };
+        let (pa, pb) = rayon_core::join(|| part(a, ka, out_a), || part(b, kb, out_b));
+        return (area + pa.0 + pb.0, deepest.max(pa.1).max(pb.1));
+    }
+    // (node, its new index, its depth); a's subtree next.
+    let mut stack = vec![(root, at, depth)];
+    while let Some((i, k, depth)) = stack.pop() {
+        let [(a, ka), (b, kb)] = place(i, k, depth, out);
+        for (c, kc) in [(b, kb), (a, ka)] {
+            if is_node(&c) {
+                stack.push((c.index, kc, depth + 1));
             }
         }
     }
-    (out, interior_area, deepest)
+    (area, deepest)
 }
 
 /// The node of two children, the one of larger surface area first. This was the order of
@@ -739,25 +933,28 @@ fn range_bounds(prims: &[PrimRef]) -> (Aabb, Aabb) {
     (b, c)
 }
 
-/// Builds the subtree of `task`; writes its interior nodes and their heights (see
-/// [`rotate_locally`]) into `tree` (this node first), and returns the reference to it as
-/// a child (an interior node: count 0, index into the node array; or a leaf: count > 0,
-/// index = first BVH slot) with its height (0 for a leaf). Each node makes its rotations
-/// as soon as its subtree is built.
+/// Builds the subtree of `task`; writes its interior nodes and their [`NodeInfo`] into
+/// `tree` (this node first) and its leaves' triangle areas (from `tri_area`, per
+/// triangle), and returns the
+/// reference to it as a child (an interior node: count 0, index into the node array; or
+/// a leaf: count > 0, index = first BVH slot). Each node makes its rotations as soon as
+/// its subtree is built.
 fn build_node(
     task: Task<'_>,
     tree: &mut Region,
     tally: &mut Tally,
     limits: &Limits,
-) -> (BvhChild, u8) {
+    tri_area: &[f32],
+) -> BvhChild {
     let n = task.prims.len();
     let area = task.bounds.half_area();
-    let leaf = |tally: &mut Tally| {
+    let leaf = |tally: &mut Tally, tree: &mut Region| {
         tally.leaf(n, area);
-        (task.bounds.child(task.first, n as u32), 0)
+        tree.write_leaf(task.first, task.ids, tri_area);
+        task.bounds.child(task.first, n as u32)
     };
     if n == 1 || task.depth >= limits.max_depth {
-        return leaf(tally);
+        return leaf(tally, tree);
     }
 
     let leaf_cost = SAH_INTERSECT_COST * n as f32 * area;
@@ -769,7 +966,7 @@ fn build_node(
     let (k, lb, lc, rb, rc) = if n <= SMALL_RANGE {
         let sweep = SmallSweep::new(task.prims);
         if worth_a_leaf(sweep.cost) {
-            return leaf(tally);
+            return leaf(tally, tree);
         }
         sweep.apply(task.prims, task.ids)
     } else {
@@ -778,7 +975,7 @@ fn build_node(
         match find_split(task.prims, &task.cbounds, parallel) {
             Some(split) => {
                 if worth_a_leaf(split.cost) {
-                    return leaf(tally);
+                    return leaf(tally, tree);
                 }
                 let (k, lc, rc) = partition(task.prims, task.ids, &task.cbounds, &split);
                 debug_assert!(k > 0 && k < n);
@@ -815,14 +1012,13 @@ fn build_node(
         depth,
     };
 
-    let ((a, ha), (b, hb)) = if task.depth < limits.par_levels && n >= PARALLEL_MIN_PRIMS {
+    let (a, b) = if limits.parallel && n >= PARALLEL_MIN_PRIMS {
         let mut right_tally = Tally::default();
-        let (mut left_tree, mut right_tree) = tree.split(k);
-        let (a, b) = std::thread::scope(|s| {
-            let handle = s.spawn(|| build_node(right, &mut right_tree, &mut right_tally, limits));
-            let a = build_node(left, &mut left_tree, tally, limits);
-            (a, handle.join().expect("BVH build thread panicked"))
-        });
+        let (mut left_tree, mut right_tree) = tree.split(k, task.first);
+        let (a, b) = rayon_core::join(
+            || build_node(left, &mut left_tree, tally, limits, tri_area),
+            || build_node(right, &mut right_tree, &mut right_tally, limits, tri_area),
+        );
         // This subtree now ends where the right one's nodes end (the left one's unused
         // places stay a gap).
         let right_end = right_tree.base + right_tree.used;
@@ -830,15 +1026,14 @@ fn build_node(
         tally.merge(right_tally);
         (a, b)
     } else {
-        let a = build_node(left, tree, tally, limits);
-        let b = build_node(right, tree, tally, limits);
+        let a = build_node(left, tree, tally, limits, tri_area);
+        let b = build_node(right, tree, tally, limits, tri_area);
         (a, b)
     };
-    tree.set(slot, larger_first(a, b), 1 + ha.max(hb));
+    tree.set(slot, larger_first(a, b));
     let mut budget = limits.rotation_budget;
     rotate_locally(tree, slot, task.depth, limits.max_depth, &mut budget);
-    let node = task.bounds.child(slot as u32, 0);
-    (node, tree.height(&node))
+    task.bounds.child(slot as u32, 0)
 }
 
 /// Exact SAH sweep of a small range (2..=SMALL_RANGE primitives): for each axis the
@@ -959,17 +1154,14 @@ fn find_split(prims: &[PrimRef], cbounds: &Aabb, parallel: bool) -> Option<Split
     let binner = Binner::new(cbounds, nb);
     let (bins, counts) = if parallel && threads() > 1 {
         let chunk = prims.len().div_ceil(threads());
-        let parts: Vec<Bins> = std::thread::scope(|s| {
-            let handles: Vec<_> = prims
-                .chunks(chunk)
-                .map(|c| s.spawn(|| bin_range(c, &binner)))
-                .collect();
-            handles
-                .into_iter()
-                .map(|h| h.join().expect("BVH build thread panicked"))
-                .collect()
+        let mut parts: Vec<Option<Bins>> = prims.chunks(chunk).map(|_| None).collect();
+        let binner = &binner;
+        rayon_core::scope(|s| {
+            for (c, part) in prims.chunks(chunk).zip(&mut parts) {
+                s.spawn(move |_| *part = Some(bin_range(c, binner)));
+            }
         });
-        let mut parts = parts.into_iter();
+        let mut parts = parts.into_iter().map(|p| p.expect("every chunk ran"));
         let (mut bins, mut counts) = parts.next().expect("at least one chunk");
         for (b, c) in parts {
             for axis in 0..3 {
@@ -1123,6 +1315,7 @@ fn stats(
         max_leaf_size: t.max_leaf_size,
         oversized_leaves: t.oversized_leaves,
         sah_cost: (SAH_TRAVERSAL_COST as f64 + cost) as f32,
+        phases: vec![],
     }
 }
 
@@ -1170,5 +1363,6 @@ pub(super) fn stats_by_walk(bvh: &Bvh) -> BuildStats {
         Instant::now(),
     );
     s.build_ms = bvh.build_stats.build_ms;
+    s.phases = bvh.build_stats.phases.clone();
     s
 }
