@@ -274,22 +274,33 @@ fn threads() -> usize {
     rayon_core::current_num_threads()
 }
 
-/// Runs `f(chunk_start, chunk)` over `data` split into chunks, each a multiple of `align`
-/// long, on all threads; returns the results in chunk order. Four chunks per thread,
-/// taken by whichever thread is free, so that uneven work (the few triangles that split
-/// clipping cuts) does not wait for one thread.
-pub(super) fn par_chunks<T: Send, R: Send, F>(data: &mut [T], align: usize, f: F) -> Vec<R>
+/// Runs `f(chunk_start, chunk)` over `data` split into chunks on all threads; returns
+/// the results in chunk order. Four chunks per thread, taken by whichever thread is free,
+/// so that uneven work (the few triangles that split clipping cuts) does not wait for
+/// one thread.
+pub(super) fn par_chunks<T: Send, R: Send, F>(data: &mut [T], f: F) -> Vec<R>
 where
     F: Fn(usize, &mut [T]) -> R + Sync,
 {
-    let Some(chunk) = chunk_len(data.len(), align) else {
-        return vec![f(0, data)];
+    let mut none = vec![(); data.len()];
+    par_chunks_zip(data, &mut none, |base, chunk, _| f(base, chunk))
+}
+
+/// [`par_chunks`] over two slices of one length, split alike: `f(chunk_start, a, b)`.
+fn par_chunks_zip<A: Send, B: Send, R: Send, F>(a: &mut [A], b: &mut [B], f: F) -> Vec<R>
+where
+    F: Fn(usize, &mut [A], &mut [B]) -> R + Sync,
+{
+    assert_eq!(a.len(), b.len(), "slices of one length");
+    let Some(chunk) = chunk_len(a.len()) else {
+        return vec![f(0, a, b)];
     };
-    let mut results: Vec<Option<R>> = data.chunks(chunk).map(|_| None).collect();
+    let mut results: Vec<Option<R>> = a.chunks(chunk).map(|_| None).collect();
     let f = &f;
     rayon_core::scope(|s| {
-        for (k, (c, r)) in data.chunks_mut(chunk).zip(&mut results).enumerate() {
-            s.spawn(move |_| *r = Some(f(k * chunk, c)));
+        let chunks = a.chunks_mut(chunk).zip(b.chunks_mut(chunk));
+        for (k, ((ca, cb), r)) in chunks.zip(&mut results).enumerate() {
+            s.spawn(move |_| *r = Some(f(k * chunk, ca, cb)));
         }
     });
     results
@@ -298,38 +309,59 @@ where
         .collect()
 }
 
-/// A vector of `n` items (with room for `spare` more) made on all threads: item i is
-/// `item(i)`, and `reduce` runs over each chunk once it is written (its results come
-/// in chunk order). The threads write the memory once: zeroed first, as `vec!` does, it
-/// would be written twice, the first time in one thread when the allocator reuses
-/// memory (docs/PERFORMANCE.md attempt 111).
-fn par_vec<T, R, I, G>(n: usize, spare: usize, item: I, reduce: G) -> (Vec<T>, Vec<R>)
+/// Two vectors of `n` items (the first with room for `spare` more) made on all threads:
+/// items i are `item(i)`, and `reduce` runs over each chunk of the first once it is
+/// written (its results come in chunk order). The threads write the memory once: zeroed
+/// first, as `vec!` does, it would be written twice, the first time in one thread when
+/// the allocator reuses memory (docs/PERFORMANCE.md attempt 111).
+fn par_vec2<A, B, R, I, G>(n: usize, spare: usize, item: I, reduce: G) -> (Vec<A>, Vec<B>, Vec<R>)
+where
+    A: Send + Sync,
+    B: Send,
+    R: Send,
+    I: Fn(usize) -> (A, B) + Sync,
+    G: Fn(&[A]) -> R + Sync,
+{
+    let mut va: Vec<A> = Vec::with_capacity(n + spare);
+    let mut vb: Vec<B> = Vec::with_capacity(n);
+    let results = par_chunks_zip(
+        &mut va.spare_capacity_mut()[..n],
+        &mut vb.spare_capacity_mut()[..n],
+        |base, ca, cb| {
+            for (k, (sa, sb)) in ca.iter_mut().zip(cb).enumerate() {
+                let (a, b) = item(base + k);
+                sa.write(a);
+                sb.write(b);
+            }
+            // SAFETY: every element of the chunk was initialised just above, and
+            // MaybeUninit<A> has the layout of A.
+            let done = unsafe { &*(ca as *const [std::mem::MaybeUninit<A>] as *const [A]) };
+            reduce(done)
+        },
+    );
+    // SAFETY: par_chunks_zip ran the closure above over every chunk of the first n
+    // elements of both (a panic in it would have ended this function), and it
+    // initialised each of them.
+    unsafe {
+        va.set_len(n);
+        vb.set_len(n);
+    }
+    (va, vb, results)
+}
+
+/// [`par_vec2`] for one vector.
+fn par_vec<T, I>(n: usize, item: I) -> Vec<T>
 where
     T: Send + Sync,
-    R: Send,
     I: Fn(usize) -> T + Sync,
-    G: Fn(&[T]) -> R + Sync,
 {
-    let mut v: Vec<T> = Vec::with_capacity(n + spare);
-    let results = par_chunks(&mut v.spare_capacity_mut()[..n], 1, |base, chunk| {
-        for (k, slot) in chunk.iter_mut().enumerate() {
-            slot.write(item(base + k));
-        }
-        // SAFETY: every element of the chunk was initialised just above, and
-        // MaybeUninit<T> has the layout of T.
-        let done = unsafe { &*(chunk as *const [std::mem::MaybeUninit<T>] as *const [T]) };
-        reduce(done)
-    });
-    // SAFETY: par_chunks ran the closure above over every chunk of the first n elements
-    // (a panic in it would have ended this function), and it initialised each of them.
-    unsafe { v.set_len(n) };
-    (v, results)
+    par_vec2(n, 0, |i| (item(i), ()), |_| ()).0
 }
 
 /// The chunk length of [`par_chunks`] for `n` items, or None where one thread does it all.
-fn chunk_len(n: usize, align: usize) -> Option<usize> {
+fn chunk_len(n: usize) -> Option<usize> {
     let t = threads();
-    (t > 1 && n >= 4096).then(|| n.div_ceil(4 * t).next_multiple_of(align))
+    (t > 1 && n >= 4096).then(|| n.div_ceil(4 * t))
 }
 
 /// Counts and areas gathered while building, for [`BuildStats`].
@@ -441,15 +473,10 @@ where
     // Per slot the x, y and z rows of its vertices (see Bvh::tri_rows). In a pass of its
     // own rather than at the leaves: the reads of scattered triangles overlap here, and
     // the leaves took twice as long over them (docs/PERFORMANCE.md attempt 111).
-    let (rows, _) = par_vec(
-        refs,
-        0,
-        |slot| {
-            let [v0, v1, v2] = tri(ids[slot] as usize);
-            [0, 1, 2].map(|axis| [v0[axis], v1[axis], v2[axis], 0.0])
-        },
-        |_| (),
-    );
+    let rows = par_vec(refs, |slot| {
+        let [v0, v1, v2] = tri(ids[slot] as usize);
+        [0, 1, 2].map(|axis| [v0[axis], v1[axis], v2[axis], 0.0])
+    });
     let tri_rows: Vec<[f32; 4]> = bytemuck::allocation::cast_vec(rows);
     phases.lap("rows");
 
@@ -514,7 +541,7 @@ pub(super) fn whole_references<F>(
 where
     F: Fn(usize) -> [Vec3; 3] + Sync,
 {
-    let (prims, chunk_bounds) = par_vec(
+    let (prims, areas, chunk_bounds) = par_vec2(
         count,
         spare,
         |i| {
@@ -523,30 +550,18 @@ where
             // A triangle with a non-finite vertex is never hit (the triangle test fails
             // on it); a point box keeps it out of everyone's way and keeps centroids
             // comparable (no NaN), which the sort of SmallSweep relies on.
-            if lo.is_finite() && hi.is_finite() {
+            let prim = if lo.is_finite() && hi.is_finite() {
                 PrimRef { lo, hi }
             } else {
                 PrimRef {
                     lo: Vec3A::ZERO,
                     hi: Vec3A::ZERO,
                 }
-            }
+            };
+            let area = 0.5 * (b - a).cross(c - a).length();
+            (prim, if area.is_finite() { area } else { 0.0 })
         },
         range_bounds,
-    );
-    let (areas, _) = par_vec(
-        count,
-        0,
-        |i| {
-            let [a, b, c] = tri(i).map(Vec3A::from);
-            let area = 0.5 * (b - a).cross(c - a).length();
-            if area.is_finite() {
-                area
-            } else {
-                0.0
-            }
-        },
-        |_| (),
     );
     let (mut bounds, mut cbounds) = (Aabb::EMPTY, Aabb::EMPTY);
     for (b, c) in chunk_bounds {

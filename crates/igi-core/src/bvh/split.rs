@@ -124,7 +124,7 @@ where
     F: Fn(usize) -> [Vec3; 3] + Sync,
 {
     let min_waste = SPLIT_MIN_WASTE * bounds.half_area();
-    let parts = par_chunks(prims, 1, |start, chunk| {
+    let parts = par_chunks(prims, |start, chunk| {
         let (mut more, mut more_ids) = (vec![], vec![]);
         let mut pieces = vec![];
         let mut cbounds = Aabb::EMPTY;
