@@ -223,7 +223,8 @@ pub struct BuildStats {
     /// sum over interior nodes of C_t A(n)/A(root) + sum over leaves of C_i N A(l)/A(root).
     pub sah_cost: f32,
     /// Wall time of the build's phases in milliseconds, in order: the references (and
-    /// their split clipping), the tree, the layout.
+    /// their split clipping), the node arrays' allocation, the tree, the rows, the
+    /// layout.
     pub phases: Vec<(&'static str, f64)>,
 }
 

@@ -419,7 +419,7 @@ where
     ids.extend(0..count as u32);
     phases.lap("references");
     if limits.split {
-        cbounds = super::split::split_references(&mut prims, &mut ids, &bounds, &tri);
+        cbounds = super::split::split_references(&mut prims, &mut ids, &tri_area, &bounds, &tri);
         phases.lap("split clipping");
     }
     // References: one per triangle, or more with early split clipping.
@@ -436,6 +436,7 @@ where
     let mut nodes: Vec<BvhNode> = bytemuck::zeroed_vec(places);
     let mut info: Vec<NodeInfo> = bytemuck::zeroed_vec(places);
     let mut slot_area = vec![0.0f32; refs];
+    phases.lap("node arrays");
     let mut tally = Tally::default();
     let root = build_node(
         Task {

@@ -110,13 +110,15 @@ impl Poly {
 }
 
 /// Early split clipping of the references of whole triangles (`prims[i]`: the box of
-/// triangle i, `bounds`: the box of them all): a triangle that is cut keeps its first
+/// triangle i, `areas[i]` its area, `bounds`: the box of them all): a triangle that is
+/// cut keeps its first
 /// piece in its own slot and appends the others, with its index, to `prims` and `ids`.
 /// Returns the new box of the doubled centroids. The same on any number of threads:
 /// the appended pieces come in triangle order.
 pub(super) fn split_references<F>(
     prims: &mut Vec<PrimRef>,
     ids: &mut Vec<u32>,
+    areas: &[f32],
     bounds: &Aabb,
     tri: &F,
 ) -> Aabb
@@ -129,11 +131,13 @@ where
         let mut pieces = vec![];
         let mut cbounds = Aabb::EMPTY;
         for (k, p) in chunk.iter_mut().enumerate() {
-            // Cheap test first: a box cannot waste more than its own half area (most
-            // triangles stop here, without reading their vertices).
+            // A cheap test first, without reading the vertices: the whole triangle must
+            // waste what split_piece asks of a piece (its area is the one split_piece
+            // computes; most triangles stop here).
             let b = Aabb { lo: p.lo, hi: p.hi };
-            if b.half_area() > min_waste {
-                let i = start + k;
+            let i = start + k;
+            let waste = b.half_area() - SPLIT_RATIO * areas[i];
+            if waste > 0.0 && waste > min_waste {
                 pieces.clear();
                 references_of(tri(i), b, min_waste, &mut pieces);
                 *p = pieces[0];
