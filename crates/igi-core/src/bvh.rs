@@ -179,11 +179,11 @@ pub enum BvhBuilder {
     /// Binned SAH over references with early split clipping (the `split` submodule:
     /// Ernst and Greiner 2007): the few long thin triangles whose boxes waste the most
     /// area are cut into pieces with tighter boxes. On the conference room 17% more
-    /// references and about 1.2 times the build time of `Binned` (attempt 111), and every ray query
-    /// and frame faster on the H200 (docs/PERFORMANCE.md, attempts 77, 79 and 80). Every
-    /// exact query answers as with `Binned` (closest-hit ties between triangles at one
-    /// distance aside); imperfect visibility finds less false occlusion. The commands'
-    /// default.
+    /// references and about 1.2 times the build time of `Binned` (attempt 111), and
+    /// every ray query and frame faster on the H200 (docs/PERFORMANCE.md, attempts 77,
+    /// 79 and 80). Every exact query answers as with `Binned` (closest-hit ties between
+    /// triangles at one distance aside); imperfect visibility finds less false
+    /// occlusion. The commands' default.
     #[default]
     Split,
     /// Binned SAH over whole triangles (the `build` submodule, [`Bvh::build`]): the
