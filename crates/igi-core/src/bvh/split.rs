@@ -111,8 +111,8 @@ impl Poly {
 
 /// Early split clipping of the references of whole triangles (`prims[i]`: the box of
 /// triangle i, `areas[i]` its area, `bounds`: the box of them all): a triangle that is
-/// cut keeps its first
-/// piece in its own slot and appends the others, with its index, to `prims` and `ids`.
+/// cut keeps its first piece in its own slot and appends the others, with its index, to
+/// `prims` and `ids`.
 /// Returns the new box of the doubled centroids. The same on any number of threads:
 /// the appended pieces come in triangle order.
 pub(super) fn split_references<F>(
@@ -136,8 +136,7 @@ where
             // computes; most triangles stop here).
             let b = Aabb { lo: p.lo, hi: p.hi };
             let i = start + k;
-            let waste = b.half_area() - SPLIT_RATIO * areas[i];
-            if waste > 0.0 && waste > min_waste {
+            if wastes(&b, areas[i], min_waste) {
                 pieces.clear();
                 references_of(tri(i), b, min_waste, &mut pieces);
                 *p = pieces[0];
@@ -158,6 +157,14 @@ where
         cbounds.grow(&c);
     }
     cbounds
+}
+
+/// Whether a box `b` around a piece of triangle of area `area` wastes enough to be cut:
+/// more than [`SPLIT_RATIO`] times the area, by more than `min_waste` (false for a NaN
+/// area).
+fn wastes(b: &Aabb, area: f32, min_waste: f32) -> bool {
+    let waste = b.half_area() - SPLIT_RATIO * area;
+    waste > 0.0 && waste > min_waste
 }
 
 /// Appends the references of one triangle whose box `b` is that of its finite vertices
@@ -188,8 +195,7 @@ fn split_piece(
     depth: u32,
     out: &mut Vec<PrimRef>,
 ) {
-    let waste = b.half_area() - SPLIT_RATIO * poly.area();
-    if depth == 0 || poly.n < 3 || !(waste > 0.0 && waste > min_waste) {
+    if depth == 0 || poly.n < 3 || !wastes(&b, poly.area(), min_waste) {
         out.push(PrimRef { lo: b.lo, hi: b.hi });
         return;
     }

@@ -60,6 +60,22 @@ fn check_structure_of(bvh: &Bvh, tris: &[[Vec3; 3]], builder: BvhBuilder) {
     if builder == BvhBuilder::Binned {
         assert_eq!(refs, n);
     }
+    // Every phase of the build timed once, in order (a build of no triangles has none).
+    let phases: Vec<&str> = bvh.build_stats.phases.iter().map(|p| p.0).collect();
+    let expected: &[&str] = match (n, builder) {
+        (0, _) => &[],
+        (_, BvhBuilder::Binned) => &["references", "node arrays", "tree", "rows", "layout"],
+        (_, BvhBuilder::Split) => &[
+            "references",
+            "split clipping",
+            "node arrays",
+            "tree",
+            "rows",
+            "layout",
+        ],
+    };
+    assert_eq!(phases, expected);
+    assert!(bvh.build_stats.phases.iter().all(|p| p.1 >= 0.0));
     assert_eq!(bvh.tri_rows.len(), 3 * refs);
     let mut seen = vec![false; n];
     for (slot, &i) in bvh.tri_order.iter().enumerate() {
