@@ -94,6 +94,22 @@ fn output_in_missing_directory() {
 }
 
 #[test]
+fn missing_files_other_than_scenes_are_named_in_words() {
+    let d = temp_dir("missing-inputs");
+    let nowhere = d.join("nowhere.exr");
+    let nowhere = nowhere.to_str().unwrap();
+    for args in [
+        vec!["compare", nowhere, nowhere],
+        vec!["bench", "rays", "builtin:cornell-box", "--load", nowhere],
+    ] {
+        let out = igi(&args);
+        assert_one_error_line(&out, &[nowhere, "No such file or directory"]);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!stderr.contains("os error"), "{args:?}: {stderr}");
+    }
+}
+
+#[test]
 fn unknown_builtin() {
     let out = igi(&["render", "--builtin", "teapot", "-o", "/tmp/x.png"]);
     assert_one_error_line(&out, &["teapot", "cornell-box"]);

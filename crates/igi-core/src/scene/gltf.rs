@@ -113,7 +113,7 @@ pub fn load_gltf(path: &Path) -> Result<GltfMesh, SceneError> {
         what: "mesh",
         path: path.to_path_buf(),
         context: None,
-        source,
+        error: source,
     })?;
     load_gltf_bytes(&bytes, path)
 }
@@ -544,7 +544,7 @@ impl Reader {
                         what: "glTF buffer",
                         path: p.clone(),
                         context: Some(format!("buffer {i} of {}", self.file)),
-                        source,
+                        error: source,
                     })?;
                     self.out.files.push(p);
                     data

@@ -134,15 +134,16 @@ impl std::fmt::Display for Location {
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
     /// A file could not be read: missing, unreadable, a directory.
-    #[error("cannot read {what} '{}'{}: {}", one_line(&.path.display().to_string()), context_suffix(.context), io_message(.source))]
+    #[error("cannot read {what} '{}'{}: {}", one_line(&.path.display().to_string()), context_suffix(.context), io_message(.error))]
     Read {
         /// "scene file", "mesh" or "material library".
         what: &'static str,
         path: PathBuf,
         /// Who referenced the file, e.g. "referenced by scene.toml".
         context: Option<String>,
-        #[source]
-        source: io::Error,
+        /// The cause, whose message the error's own includes (so it is not also its
+        /// `source()`, which would print it twice in a chain of causes).
+        error: io::Error,
     },
     /// The file is not well-formed: TOML syntax or types, OBJ or MTL syntax, not text.
     #[error("{at}: {message}")]
@@ -383,7 +384,7 @@ pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
         what: "scene file",
         path: path.to_path_buf(),
         context: None,
-        source,
+        error: source,
     })?;
     let name = path.display().to_string();
     let text = as_text(&bytes, &name)?;
@@ -482,7 +483,7 @@ pub fn load_scene_str(toml_text: &str, base_dir: &Path, name: &str) -> Result<Sc
             what: "mesh",
             path: obj_path.clone(),
             context: Some(format!("referenced by {name}")),
-            source,
+            error: source,
         })?;
         files.push(obj_path.clone());
         let first_slot = slots.len();
@@ -1362,7 +1363,7 @@ fn load_obj(
                     what: "material library",
                     path: lib_path,
                     context: Some(format!("mtllib at {file}:{ln}")),
-                    source,
+                    error: source,
                 })
             }
         }

@@ -41,4 +41,22 @@ pub fn assert_one_error_line(out: &Output, needles: &[&str]) {
     for n in needles {
         assert!(lines[0].contains(n), "'{}' does not name '{n}'", lines[0]);
     }
+    assert_no_repeated_clause(lines[0]);
+}
+
+/// An error line says each thing once: no clause (the parts between ": ") comes back
+/// later in the line, as when an error prints its cause and the chain of causes prints
+/// it again.
+pub fn assert_no_repeated_clause(line: &str) {
+    let clauses: Vec<&str> = line
+        .split(": ")
+        .map(|c| match c.rfind(" (os error ") {
+            Some(i) if c.ends_with(')') => c[..i].trim(),
+            _ => c.trim(),
+        })
+        .filter(|c| c.len() > 3)
+        .collect();
+    for (i, c) in clauses.iter().enumerate() {
+        assert!(!clauses[i + 1..].contains(c), "'{c}' said twice in: {line}");
+    }
 }
