@@ -27,6 +27,7 @@
 //! pieces that early split clipping (`split`) cut the wasteful ones into; the build is
 //! the same.
 
+use std::mem::MaybeUninit;
 use std::time::Instant;
 
 use glam::{Vec3, Vec3A};
@@ -429,12 +430,16 @@ where
         "too many triangle references for one BVH: {refs}"
     );
 
-    // Room for refs - 1 interior nodes, the most a tree over refs references has; zeroed
-    // by the allocator, so that the places no subtree writes (see Region) are never
-    // touched.
+    // Room for refs - 1 interior nodes, the most a tree over refs references has, left
+    // unwritten (see Places).
     let places = refs.max(2) - 1;
-    let mut nodes: Vec<BvhNode> = bytemuck::zeroed_vec(places);
-    let mut info: Vec<NodeInfo> = bytemuck::zeroed_vec(places);
+    let mut nodes: Box<Places<BvhNode>> = Box::new_uninit_slice(places);
+    let mut info: Box<Places<NodeInfo>> = Box::new_uninit_slice(places);
+    if cfg!(debug_assertions) {
+        // Where assertions are on (the tests), every place's info starts out written
+        // with an interior count of 0, which no set node has, and each read checks it.
+        info.fill(MaybeUninit::new(NodeInfo::default()));
+    }
     let mut slot_area = vec![0.0f32; refs];
     phases.lap("node arrays");
     let mut tally = Tally::default();
@@ -463,11 +468,14 @@ where
     if root.count > 0 {
         // A root that is a leaf still needs an interior node 0 to hold its box; the leaf
         // is its child, at depth 1, and stays child a.
-        nodes[0] = BvhNode::new(bounds.child(root.index, root.count), BvhChild::EMPTY);
-        info[0] = NodeInfo {
+        nodes[0].write(BvhNode::new(
+            bounds.child(root.index, root.count),
+            BvhChild::EMPTY,
+        ));
+        info[0].write(NodeInfo {
             interior: 1,
             ..NodeInfo::default()
-        };
+        });
     }
     phases.lap("tree");
 
@@ -596,18 +604,40 @@ struct NodeInfo {
     _pad: [u8; 2],
 }
 
+/// Places of the node array (or of the [`NodeInfo`] array) while the tree is built, left
+/// unwritten until a node is stored there: a subtree of n references gets the n - 1
+/// places it might need ([`Region`]) and uses about half of them, and zeroing them all
+/// cost 2.5-4 ms a build on the 2-core machine wherever the allocator reused memory
+/// (docs/PERFORMANCE.md attempt 112). A place is read only where a child refers to it
+/// (and the root, place 0, which is always written), and a child refers to a node only
+/// once [`Region::set`] has stored it: `build_node` hands out a node's reference after
+/// setting it, and the rotations only store nodes that were set before. So no unwritten
+/// place is read ([`written`]).
+type Places<T> = [MaybeUninit<T>];
+
+/// The node (or [`NodeInfo`]) at place `i`.
+///
+/// # Safety
+/// Place `i` must have been written: the root's place, or one a child refers to (see
+/// [`Places`]).
+#[inline]
+unsafe fn written<T: Copy>(places: &Places<T>, i: usize) -> T {
+    // SAFETY: the caller's guarantee.
+    unsafe { places[i].assume_init() }
+}
+
 /// The part of the tree's node array (and of the nodes' [`NodeInfo`]) that a subtree
 /// writes: nodes at global indices `base ..`, `used` of them so far; with the triangle
 /// areas of the BVH slots from `slot_base` on, which its leaves write. A subtree
 /// of n triangles gets n - 1 places, the most it can need; one built on another thread
 /// gets a region of its own, carved from its parent's, so that the two sides of a split
-/// are built in place side by side. The places a subtree leaves unused stay zero and
+/// are built in place side by side. The places a subtree leaves unused stay unwritten and
 /// unreachable, and the depth-first layout drops them. (The right subtree used to be
 /// built in a vector of its own and copied behind the left one: 6 ms of copies, mostly
 /// after joins, on the conference room; docs/PERFORMANCE.md attempt 63.)
 struct Region<'a> {
-    nodes: &'a mut [BvhNode],
-    info: &'a mut [NodeInfo],
+    nodes: &'a mut Places<BvhNode>,
+    info: &'a mut Places<NodeInfo>,
     base: usize,
     used: usize,
     /// Per slot the area of its triangle (0 for a non-finite one).
@@ -622,12 +652,19 @@ impl Region<'_> {
         self.base + self.used - 1
     }
 
+    /// Node `i`, which must have been set: node `i` being built or rotated, or a child's.
     fn node(&self, i: usize) -> BvhNode {
-        self.nodes[i - self.base]
+        debug_assert!(self.info(i).interior > 0, "node {i} read before it was set");
+        // SAFETY: every caller passes such an index (see Places).
+        unsafe { written(self.nodes, i - self.base) }
     }
 
-    fn info(&self, i: usize) -> &NodeInfo {
-        &self.info[i - self.base]
+    /// Node `i`'s info, as for [`Region::node`].
+    fn info(&self, i: usize) -> NodeInfo {
+        // SAFETY: as in Region::node.
+        let info = unsafe { written(self.info, i - self.base) };
+        debug_assert!(info.interior > 0, "node {i}'s info read before it was set");
+        info
     }
 
     /// Stores node `i`, whose children are final, with its [`NodeInfo`].
@@ -642,8 +679,7 @@ impl Region<'_> {
         } else {
             (area_a + area_b, visit + cost_a + cost_b)
         };
-        self.nodes[i - self.base] = node;
-        self.info[i - self.base] = NodeInfo {
+        let info = NodeInfo {
             area,
             cost,
             interior: 1 + self.interior(&a) + self.interior(&b),
@@ -651,6 +687,8 @@ impl Region<'_> {
             swap: u8::from(swap),
             _pad: [0; 2],
         };
+        self.nodes[i - self.base].write(node);
+        self.info[i - self.base].write(info);
     }
 
     /// Levels below a child: 0 for a leaf, its node's height for an interior node.
@@ -839,8 +877,13 @@ const LAYOUT_SPLIT_LEVELS: u32 = 2;
 /// [`NodeInfo`] place every node at once, so the top subtrees are laid out on separate
 /// threads: on the conference room the one walk it replaced took 3.9-10 ms of the 2-core
 /// machine, and the ordering pass after it 7.5-9 ms (docs/PERFORMANCE.md attempt 111).
-fn depth_first_layout(nodes: &[BvhNode], info: &[NodeInfo]) -> (Vec<BvhNode>, f64, u32) {
-    let mut out: Vec<BvhNode> = bytemuck::zeroed_vec(info[0].interior as usize);
+fn depth_first_layout(
+    nodes: &Places<BvhNode>,
+    info: &Places<NodeInfo>,
+) -> (Vec<BvhNode>, f64, u32) {
+    // SAFETY: the root's place is written (see Places).
+    let root_info = unsafe { written(info, 0) };
+    let mut out: Vec<BvhNode> = bytemuck::zeroed_vec(root_info.interior as usize);
     let (area, deepest) = lay_out(nodes, info, 0, &mut out, 0, 0);
     (out, area, deepest)
 }
@@ -848,8 +891,8 @@ fn depth_first_layout(nodes: &[BvhNode], info: &[NodeInfo]) -> (Vec<BvhNode>, f6
 /// Lays out the subtree of node `root` (at `depth`) into `out`, whose first place has the
 /// global index `at`; returns its statistics (see [`depth_first_layout`]).
 fn lay_out(
-    nodes: &[BvhNode],
-    info: &[NodeInfo],
+    nodes: &Places<BvhNode>,
+    info: &Places<NodeInfo>,
     root: u32,
     out: &mut [BvhNode],
     at: u32,
@@ -858,11 +901,15 @@ fn lay_out(
     let (mut area, mut deepest) = (0.0f64, 0u32);
     // The node at its new place, and where its children's subtrees go.
     let mut place = |i: u32, k: u32, depth: u32, out: &mut [BvhNode]| {
-        let n = nodes[i as usize];
+        // SAFETY: i is the root or a child's node, a written place (see Places); so are
+        // the interior children's below.
+        let (n, node_info) = unsafe { (written(nodes, i as usize), written(info, i as usize)) };
+        debug_assert!(node_info.interior > 0, "node {i} laid out but never set");
         let (a, b) = (n.a(), n.b());
         let interior = |c: &BvhChild| {
             if is_node(c) {
-                info[c.index as usize].interior
+                // SAFETY: see above.
+                unsafe { written(info, c.index as usize).interior }
             } else {
                 0
             }
@@ -883,7 +930,7 @@ fn lay_out(
         if is_node(&b) {
             m.b_index = kb;
         }
-        if info[i as usize].swap != 0 {
+        if node_info.swap != 0 {
             m = BvhNode::new(m.b(), m.a());
         }
         out[(k - at) as usize] = m;
