@@ -460,6 +460,12 @@ impl Renderer {
         Ok(())
     }
 
+    /// Dispatches of each gather in the last frame: one per range of the VPL list (see
+    /// `submit_frame`).
+    pub fn gather_ranges(&self) -> u32 {
+        self.range_buffer.as_ref().map_or(0, |r| r.2)
+    }
+
     /// Write the VPL ranges for a frame of `slots` VPL slots (an upper bound of the VPL
     /// count, which only the GPU knows) and return how many there are. Entry 0 is the
     /// direct pass's first walk (no VPLs, `first_walk` = 1), entries 1..=count the ranges.
@@ -607,6 +613,33 @@ impl Renderer {
         self.ensure_permutations(ctx, settings.seed);
         self.ensure_vpl_slots(ctx, PILOT_PATHS as u64 * bounces as u64)?;
         let params = self.frame_params(settings, PILOT_PATHS, pilot_base(settings.seed), 0);
+        let pilot_vpls = self.count_vpls(ctx, &params, "vpl pilot")?;
+        let per_path = pilot_vpls as f64 / PILOT_PATHS as f64;
+        let paths = if per_path > 0.0 {
+            (settings.vpls as f64 / per_path)
+                .round()
+                .clamp(1.0, u32::MAX as f64 / 64.0) as u32
+        } else {
+            // The lights reach no surface: no VPLs whatever the count.
+            settings.vpls.max(1)
+        };
+        self.path_cache = Some((key, paths));
+        Ok(paths)
+    }
+
+    /// The VPLs that the light paths of `params` leave: the VPL pass run alone, untimed
+    /// and uncounted, and its count read back (the VPL buffers must hold the paths'
+    /// slots).
+    fn count_vpls(
+        &mut self,
+        ctx: &GpuContext,
+        params: &FrameParams,
+        label: &'static str,
+    ) -> Result<u32, GpuError> {
+        let params = FrameParams {
+            count_rays: 0,
+            ..*params
+        };
         ctx.queue
             .write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
         let vb = self.vpl_buffers.as_ref().expect("allocated");
@@ -620,11 +653,11 @@ impl Renderer {
         );
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
         let untimed = Profiler::disabled();
-        let steps = self.vpl.steps(PILOT_PATHS);
+        let steps = self.vpl.steps(params.path_count);
         let steps: Vec<_> = std::iter::once(steps.shoot).chain(steps.compact).collect();
-        Recorder::new(&mut encoder, &untimed, "vpl pilot").dispatch(
+        Recorder::new(&mut encoder, &untimed, label).dispatch(
             0,
-            "vpl pilot",
+            label,
             &steps,
             &self.scene.bind_group,
             &bind,
@@ -632,17 +665,7 @@ impl Renderer {
         );
         ctx.queue.submit([encoder.finish()]);
         let header: Vec<u32> = ctx.read_buffer(&self.vpl_header)?;
-        let per_path = header[0] as f64 / PILOT_PATHS as f64;
-        let paths = if per_path > 0.0 {
-            (settings.vpls as f64 / per_path)
-                .round()
-                .clamp(1.0, u32::MAX as f64 / 64.0) as u32
-        } else {
-            // The lights reach no surface: no VPLs whatever the count.
-            settings.vpls.max(1)
-        };
-        self.path_cache = Some((key, paths));
-        Ok(paths)
+        Ok(header[0])
     }
 
     /// Render a frame (or `settings.accumulate` frames averaged, each with a fresh VPL set)
@@ -723,13 +746,26 @@ impl Renderer {
         let bounces = settings.bounces.max(1);
         self.ensure_vpl_slots(ctx, paths as u64 * bounces as u64)?;
         self.ensure_images(ctx, settings.width, settings.height)?;
-        self.ensure_ranges(ctx, paths as u64 * bounces as u64);
         let mut params = self.frame_params(
             settings,
             paths,
             halton_base(settings.seed, settings.frame, paths),
             accumulate_index,
         );
+        // The gathers take the VPL list in ranges: one on GPUs, of vpls_per_dispatch on
+        // software adapters, where each range is a dispatch of every gather, which costs
+        // there even when the range is past the last VPL. So there the frame's VPLs are
+        // counted first, by its own VPL pass run alone (the same paths leave the same
+        // VPLs when the frame runs it again), and the ranges cover them, not every slot
+        // the paths could fill: where most paths leave the scene at once the two differ a
+        // hundredfold (one mirror triangle: 9 VPLs in 1,872 slots, whose 234 ranges took
+        // 2.5-10 s a frame on llvmpipe).
+        let vpls = if self.vpls_per_dispatch == u32::MAX {
+            paths as u64 * bounces as u64
+        } else {
+            self.count_vpls(ctx, &params, "vpl count")? as u64
+        };
+        self.ensure_ranges(ctx, vpls);
         params.count_rays = self.counting as u32;
         ctx.queue
             .write_buffer(&self.params, 0, bytemuck::bytes_of(&params));

@@ -8,7 +8,7 @@ mod common;
 use common::*;
 use glam::Vec3;
 use igi_core::bvh::{offset_ray_origin, Bvh};
-use igi_core::scene::Scene;
+use igi_core::scene::{Camera, PointLight, Scene};
 use igi_core::settings::{InterleavePattern, OutputBuffer, RenderSettings};
 use igi_core::vpl::{reflect, surface_at};
 use igi_gpu::passes::indirect::list_pixels_per_group;
@@ -356,4 +356,58 @@ fn compare_interleaved(
         InterleavePattern::Irregular => 0.07,
     };
     assert!(rel < bound, "{pattern:?}: relative squared error {rel}");
+}
+
+/// A half-mirror square open to the sky under a light: light paths leave VPLs on the
+/// square and then leave the scene, so a frame's VPLs are far fewer than the slots its
+/// paths could fill (paths x bounces). The gathers (with mirror chains, the pass that
+/// costs most per dispatch on llvmpipe) must take one range per `vpls_per_dispatch` VPLs
+/// of the frame, not of the slots: on the software adapter, where the list is split,
+/// 234 ranges for 9 VPLs took 2.5-10 s a frame. (The tests above check what the gathers
+/// add up through those ranges.)
+#[test]
+fn gather_ranges_cover_the_frames_vpls_not_every_slot() {
+    let Some(ctx) = gpu() else {
+        return;
+    };
+    let camera = Camera {
+        eye: Vec3::new(0.2, 2.0, 1.5),
+        target: Vec3::ZERO,
+        up: Vec3::Y,
+        fov_y_deg: 60.0,
+    };
+    let scene = scene(
+        camera,
+        floor_square(1.0, 0),
+        vec![material("half mirror", Vec3::splat(0.3), Vec3::splat(0.5))],
+        vec![PointLight {
+            position: Vec3::new(0.0, 1.0, 0.0),
+            intensity: Vec3::ONE,
+        }],
+    );
+    let settings = RenderSettings {
+        width: 8,
+        height: 8,
+        vpls: 24,
+        bounces: 8,
+        mirror_depth: 2,
+        ..RenderSettings::for_scene(&scene)
+    };
+    let bvh = Bvh::build(&scene.triangles);
+    let mut renderer = Renderer::new(&ctx, &scene, &bvh).expect("renderer");
+    let frame = renderer.render(&ctx, &settings).expect("frame");
+    let per = ctx.vpls_per_dispatch();
+    let slots = frame.path_count as u64 * settings.bounces as u64;
+    assert!(
+        frame.vpl_count as u64 * 4 <= slots,
+        "the scene should leave far fewer VPLs ({}) than slots ({slots})",
+        frame.vpl_count
+    );
+    let needed = frame.vpl_count.div_ceil(per).max(1);
+    assert_eq!(
+        renderer.gather_ranges(),
+        needed,
+        "{} VPLs in ranges of {per}",
+        frame.vpl_count
+    );
 }
