@@ -89,9 +89,62 @@ impl Triangle {
     pub fn cross(&self) -> Vec3 {
         (self.v[1] - self.v[0]).cross(self.v[2] - self.v[0])
     }
+    /// Area, computed in f64: the f32 cross product of a valid triangle overflows once its
+    /// edges pass about 1e19 (and underflows below about 1e-19).
     pub fn area(&self) -> f32 {
-        0.5 * self.cross().length()
+        (0.5 * cross_f64(&self.v).length()) as f32
     }
+}
+
+/// (v1 - v0) x (v2 - v0) in f64: finite and exact enough for any finite f32 vertices.
+fn cross_f64(v: &[Vec3; 3]) -> glam::DVec3 {
+    let [a, b, c] = v.map(|p| p.as_dvec3());
+    (b - a).cross(c - a)
+}
+
+/// 2^j for j in [-126, 127], exactly (the exponent field alone).
+fn pow2(j: i32) -> f32 {
+    f32::from_bits(((127 + j) as u32) << 23)
+}
+
+/// `e` times the power of two that brings its largest component into [0.5, 1) (zero stays
+/// zero). Only exponents change, so the products of two scaled edges round exactly as the
+/// unscaled ones do, without their overflow (edges past ~1e19) or underflow. Twin of
+/// frame.wgsl's `scale_pow2`; the factor is applied in two halves so that each stays a
+/// normal f32.
+pub fn scale_pow2(e: Vec3) -> Vec3 {
+    let m = e.abs().max_element();
+    let k = 126 - ((m.to_bits() >> 23) & 0xff) as i32;
+    e * pow2(k / 2) * pow2(k - k / 2)
+}
+
+/// The unit geometric normal of the triangle `v` (on the side of its winding), or `None`
+/// when it is degenerate: zero area in f32, or edges that are not finite f32 numbers.
+/// The cross product is taken of edges scaled by powers of two ([`scale_pow2`]), as the
+/// GPU's `geometric_normal` does, so a large valid triangle (whose plain f32 cross
+/// product overflows) is kept and gets the normal the GPU computes, and every other
+/// triangle gets exactly the normal of the plain formula. The loaders keep what this
+/// accepts.
+pub fn geometric_normal(v: &[Vec3; 3]) -> Option<Vec3> {
+    let (e1, e2) = (v[1] - v[0], v[2] - v[0]);
+    if !(e1.is_finite() && e2.is_finite()) {
+        return None;
+    }
+    let c = scale_pow2(e1).cross(scale_pow2(e2));
+    // At most 2 per component: the length is finite.
+    let len = c.length();
+    (len > 0.0).then(|| c / len)
+}
+
+/// Length of the box diagonal hi - lo, in f64: its f32 square overflows once the box
+/// passes ~1.8e19 (a triangle at 1e20 among small ones made it, and the default bounding
+/// distance of G, infinite). Saturates at f32::MAX, for boxes whose diagonal itself is
+/// past the f32 range; an empty box (lo > hi) gives 0.
+pub fn diagonal_of(lo: Vec3, hi: Vec3) -> f32 {
+    let d = (hi.as_dvec3() - lo.as_dvec3())
+        .max(glam::DVec3::ZERO)
+        .length();
+    d.min(f32::MAX as f64) as f32
 }
 
 /// A loaded scene, ready for the BVH build and the GPU upload.
@@ -127,7 +180,7 @@ impl Scene {
     /// use [`Scene::ray_offset_floor`] instead.
     pub fn diagonal(&self) -> f32 {
         let (lo, hi) = self.bounds();
-        (hi - lo).length()
+        diagonal_of(lo, hi)
     }
 
     /// The least distance ray origins move off surfaces in this scene
@@ -146,6 +199,51 @@ impl Scene {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn geometric_normal_of_large_and_degenerate_triangles() {
+        let big = |e: f32| {
+            [
+                Vec3::new(-e, -e, 0.0),
+                Vec3::new(e, -e, 0.0),
+                Vec3::new(0.0, e, 0.0),
+            ]
+        };
+        // The plain f32 cross product of edges 2e10 overflows: the triangle is valid.
+        for e in [1.0, 1e10, 1e18, 1e30, 1e37] {
+            assert_eq!(geometric_normal(&big(e)), Some(Vec3::Z), "{e}");
+        }
+        assert_eq!(geometric_normal(&big(1e-30)), Some(Vec3::Z));
+        // Zero area, edges beyond f32, vertices not finite: degenerate.
+        let line = [Vec3::ZERO, Vec3::splat(1e10), Vec3::splat(2e10)];
+        assert_eq!(geometric_normal(&line), None);
+        assert_eq!(geometric_normal(&[Vec3::X; 3]), None);
+        assert_eq!(geometric_normal(&big(3e38)), None);
+        assert_eq!(geometric_normal(&[Vec3::NAN, Vec3::X, Vec3::Y]), None);
+        // Elsewhere exactly the plain formula's normal (scaling by powers of two is exact).
+        let mut x = 0x2545_f491_u32;
+        let mut r = || {
+            x ^= x << 13;
+            x ^= x >> 17;
+            x ^= x << 5;
+            (x as f32 / u32::MAX as f32 - 0.5) * 20.0
+        };
+        for _ in 0..1000 {
+            let v = [0; 3].map(|_| Vec3::new(r(), r(), r()));
+            let c = (v[1] - v[0]).cross(v[2] - v[0]);
+            assert_eq!(geometric_normal(&v), Some(c / c.length()));
+        }
+    }
+
+    #[test]
+    fn diagonal_of_far_bounds_is_finite() {
+        // |hi - lo|^2 of 1e20 overflows f32.
+        let d = diagonal_of(Vec3::ZERO, Vec3::new(1e20, 1.0, 1.0));
+        assert!((d / 1e20 - 1.0).abs() < 1e-6, "{d}");
+        assert_eq!(diagonal_of(Vec3::ZERO, Vec3::new(3.0, 4.0, 0.0)), 5.0);
+        assert_eq!(diagonal_of(Vec3::splat(-3e38), Vec3::splat(3e38)), f32::MAX);
+        assert_eq!(diagonal_of(Vec3::INFINITY, Vec3::NEG_INFINITY), 0.0);
+    }
 
     #[test]
     fn pixel_dir_looks_through_pixel_centres() {

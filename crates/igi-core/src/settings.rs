@@ -94,6 +94,10 @@ impl Default for Accelerations {
     }
 }
 
+/// What [`Accelerations::from_setup`] accepts, for its error messages.
+pub const SETUP_NAMES: &str =
+    "the set-ups are canonical, or iv, ds, il, irregular, fused joined by '+', e.g. iv+ds+il";
+
 impl Accelerations {
     /// The paper's four set-ups by name: "canonical", and any of "iv", "ds", "il" joined
     /// by '+' (e.g. "iv+ds+il"), with the paper's parameters (downsample 4, interleave
@@ -103,6 +107,11 @@ impl Accelerations {
         if name == "canonical" {
             return Ok(a);
         }
+        // The callers put the option's name in front; the name itself is repeated only
+        // where it says more than the part (a set-up of several parts).
+        if name.is_empty() {
+            return Err(format!("an empty set-up name ({SETUP_NAMES})"));
+        }
         for part in name.split('+') {
             match part {
                 "iv" => a.imperfect_visibility = true,
@@ -110,14 +119,42 @@ impl Accelerations {
                 "il" => a.interleave = (3, 3),
                 "irregular" => a.pattern = InterleavePattern::Irregular,
                 "fused" => a.filter = FilterMode::Fused,
+                "" => return Err(format!("an empty part in set-up '{name}' ({SETUP_NAMES})")),
+                other if other == name => {
+                    return Err(format!("unknown set-up '{name}' ({SETUP_NAMES})"))
+                }
                 other => {
                     return Err(format!(
-                        "unknown set-up part '{other}' in '{name}' (use canonical, or iv, ds, il, irregular, fused joined by +)"
+                        "unknown part '{other}' in set-up '{name}' ({SETUP_NAMES})"
                     ))
                 }
             }
         }
+        // The renderer ignores a pattern without subsets and a filter mode without a
+        // filter, so such a name would label a table row with what was not measured.
+        if let Some(idle) = a.idle_modifier() {
+            let (needs, example) = match idle {
+                "irregular" => ("il", "iv+ds+il+irregular"),
+                _ => ("ds or il", "iv+ds+il+fused"),
+            };
+            return Err(format!(
+                "set-up '{name}': {idle} modifies {needs}, which it lacks (e.g. {example})"
+            ));
+        }
         Ok(a)
+    }
+
+    /// The modifier in force that has nothing to modify, by its set-up name: "irregular"
+    /// (the pattern of interleaved subsets) without interleaving, or "fused" (the filter
+    /// passes in one) with neither downsampling nor interleaving, which run no filter.
+    pub fn idle_modifier(&self) -> Option<&'static str> {
+        if self.pattern == InterleavePattern::Irregular && self.interleave == (1, 1) {
+            Some("irregular")
+        } else if self.filter == FilterMode::Fused && !self.filtered() {
+            Some("fused")
+        } else {
+            None
+        }
     }
 
     /// Whether the indirect term goes through a filter at all.
@@ -193,5 +230,46 @@ impl RenderSettings {
     /// The bounding distance in force for `scene`.
     pub fn min_dist_for(&self, scene: &Scene) -> f32 {
         self.min_dist.unwrap_or_else(|| default_min_dist(scene))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn setup_names_and_their_errors() {
+        let a = Accelerations::from_setup("iv+ds+il+irregular+fused").unwrap();
+        assert!(a.imperfect_visibility && a.downsample == 4 && a.interleave == (3, 3));
+        assert_eq!(a.pattern, InterleavePattern::Irregular);
+        assert_eq!(a.filter, FilterMode::Fused);
+        assert_eq!(
+            Accelerations::from_setup("canonical").unwrap(),
+            Accelerations::default()
+        );
+        // A one-part name is said once; every error lists the valid names.
+        let e = Accelerations::from_setup("foo").unwrap_err();
+        assert_eq!(e.matches("foo").count(), 1, "{e}");
+        assert!(
+            e.contains("unknown set-up 'foo'") && e.contains("iv, ds, il"),
+            "{e}"
+        );
+        let e = Accelerations::from_setup("iv+foo").unwrap_err();
+        assert!(e.contains("unknown part 'foo' in set-up 'iv+foo'"), "{e}");
+        // Empty names and parts (a trailing ',' or '+') get their own words.
+        let e = Accelerations::from_setup("").unwrap_err();
+        assert!(
+            e.starts_with("an empty set-up name") && e.contains("canonical"),
+            "{e}"
+        );
+        let e = Accelerations::from_setup("iv+").unwrap_err();
+        assert!(e.starts_with("an empty part in set-up 'iv+'"), "{e}");
+        // A modifier without what it modifies is refused, not ignored.
+        let e = Accelerations::from_setup("iv+irregular").unwrap_err();
+        assert!(e.contains("irregular modifies il, which it lacks"), "{e}");
+        let e = Accelerations::from_setup("fused").unwrap_err();
+        assert!(e.contains("fused modifies ds or il"), "{e}");
+        assert!(Accelerations::from_setup("ds+fused").is_ok());
+        assert!(Accelerations::from_setup("il+irregular").is_ok());
     }
 }

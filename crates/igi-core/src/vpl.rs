@@ -36,7 +36,8 @@ pub fn surface_at(scene: &Scene, bvh: &Bvh, dir: Vec3, slot: u32, u: f32, v: f32
     let tri = &scene.triangles[bvh.tri_order[slot as usize] as usize];
     let w = 1.0 - u - v;
     let position = w * tri.v[0] + u * tri.v[1] + v * tri.v[2];
-    let mut ng = (tri.v[1] - tri.v[0]).cross(tri.v[2] - tri.v[0]).normalize();
+    // Twin of frame.wgsl's geometric_normal (the loaders keep only triangles that have one).
+    let mut ng = crate::scene::geometric_normal(&tri.v).unwrap_or(Vec3::Z);
     if ng.dot(dir) > 0.0 {
         ng = -ng;
     }
@@ -79,15 +80,20 @@ pub fn shoot_vpls(
     let mut out = vec![];
     for path in 0..paths {
         let index = base.wrapping_add(path);
+        // As vpl.wgsl: a light of zero power is never chosen (its p_light of 0 made the
+        // flux NaN), and a path stores nothing when no light emits.
         let mut u = halton(0, index) * power_sum;
-        let mut chosen = scene.lights.len() - 1;
+        let mut chosen = None;
         for l in 0..scene.lights.len() {
-            if u < weight(l) {
-                chosen = l;
-                break;
+            if weight(l) > 0.0 {
+                chosen = Some(l);
+                if u < weight(l) {
+                    break;
+                }
             }
             u -= weight(l);
         }
+        let Some(chosen) = chosen else { continue };
         let light = &scene.lights[chosen];
         let p_light = weight(chosen) / power_sum;
         let mut flux = 4.0 * PI * light.intensity / (p_light * paths as f32);
@@ -144,4 +150,40 @@ pub fn shoot_vpls(
 /// Mirror reflection of `d` about unit `n` (WGSL's `reflect`).
 pub fn reflect(d: Vec3, n: Vec3) -> Vec3 {
     d - 2.0 * d.dot(n) * n
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::builtin::builtin_scene;
+
+    /// Lights of zero power are never chosen (their p_light of 0 made the flux 0 / 0),
+    /// and with no light that emits there are no VPLs.
+    #[test]
+    fn lights_of_zero_power_make_no_nan() {
+        let mut scene = builtin_scene("cornell-box").unwrap();
+        let bvh = Bvh::build(&scene.triangles);
+        let perms = DigitPermutations::new(0);
+        let light = scene.lights[0];
+        let dark = crate::scene::PointLight {
+            intensity: Vec3::ZERO,
+            ..light
+        };
+        for (lights, expect_vpls) in [
+            (vec![dark], false),
+            (vec![dark, dark], false),
+            (vec![dark, light], true),
+            (vec![light, dark], true),
+            (vec![dark, light, dark], true),
+        ] {
+            scene.lights = lights;
+            let vpls = shoot_vpls(&scene, &bvh, &perms, 64, 4, 2, 0);
+            assert_eq!(!vpls.is_empty(), expect_vpls, "{:?}", scene.lights);
+            assert!(
+                vpls.iter().all(|v| v.flux.is_finite()),
+                "{:?}",
+                scene.lights
+            );
+        }
+    }
 }

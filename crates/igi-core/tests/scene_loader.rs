@@ -1160,3 +1160,167 @@ fn camera_toml_errors_name_the_key() {
     .to_string();
     assert!(e.contains("zoom"), "{e}");
 }
+
+// ---------------------------------------------------------------------------------------
+// Unusual but valid (or clearly invalid) input: lights, large triangles, vector lengths,
+// OBJ comments, values beyond the f32 range
+// ---------------------------------------------------------------------------------------
+
+#[test]
+fn light_of_zero_power_loads_and_unrepresentable_power_is_refused() {
+    // A light that emits nothing is valid (the renderer never chooses it).
+    let (dir, toml) = valid_scene("light-zero");
+    let s = dir
+        .load(&toml.replace("intensity = [1.0, 1.0, 1.0]", "intensity = [0.0, 0.0, 0.0]"))
+        .expect("a light of zero intensity is valid");
+    assert_eq!(s.lights[0].intensity, Vec3::ZERO);
+    // 4 pi (r + g + b) beyond f32::MAX: named with the light's value as written.
+    bad_toml(
+        "light-1e37",
+        "intensity = [1.0, 1.0, 1.0]",
+        "intensity = [1e37, 1e37, 1e37]",
+        true,
+        &[
+            "point_light.intensity",
+            "[1e37, 1e37, 1e37]",
+            "32-bit floats",
+        ],
+    );
+    // Each light in range, their sum not.
+    let bright = "[[point_light]]\nposition = [0.0, 0.0, 3.0]\nintensity = [1e37, 0.0, 0.0]\n";
+    let (dir, toml) = valid_scene("light-sum");
+    assert!(dir.load(&format!("{toml}\n{bright}")).is_ok());
+    let r = dir.load(&format!("{toml}\n{bright}\n{bright}\n{bright}"));
+    expect_err(r, "scene.toml", &["4 lights' total power", "32-bit floats"]);
+}
+
+#[test]
+fn large_valid_triangles_are_kept_and_degenerate_ones_dropped() {
+    // Edges of 2e10 (and 2e30): the f32 cross product overflows, the triangle is fine.
+    for e in ["1e10", "1e18", "1e30"] {
+        let obj = format!("v -{e} -{e} 0\nv {e} -{e} 0\nv 0 {e} 0\nusemtl a\nf 1 2 3\n");
+        let s = load_obj(&format!("big-{e}"), &obj, &grey("a")).expect(e);
+        assert_eq!(s.triangles.len(), 1, "{e}");
+        assert_eq!(s.triangles[0].n, [Vec3::Z; 3], "{e}");
+        if e == "1e10" {
+            // Base 2e10, height 2e10 (the f32 cross product of it was infinite).
+            let area = s.triangles[0].area();
+            assert!((area / 2e20 - 1.0).abs() < 1e-6, "area {area}");
+        }
+    }
+    // Zero area (collinear, repeated vertex) at every scale is still dropped.
+    for (tag, obj) in [
+        (
+            "collinear",
+            "v 0 0 0\nv 1e10 1e10 0\nv 2e10 2e10 0\nusemtl a\nf 1 2 3\n",
+        ),
+        (
+            "repeated",
+            "v 1e20 0 0\nv 1e20 0 0\nv 0 1e20 0\nusemtl a\nf 1 2 3\n",
+        ),
+        ("flat", "v 0 0 0\nv 1 0 0\nv 2 0 0\nusemtl a\nf 1 2 3\n"),
+    ] {
+        expect_err(
+            load_obj(tag, obj, &grey("a")),
+            "scene.toml",
+            &["no triangles"],
+        );
+    }
+}
+
+#[test]
+fn diagonal_of_far_geometry_is_finite() {
+    // One small triangle at x = 1e20 beside a unit one: |hi - lo|^2 overflows f32.
+    let obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1e20 0 0\nv 1e20 1 0\nv 1e20 0 1\nusemtl a\nf 1 2 3\nf 4 5 6\n";
+    let s = load_obj("far", obj, &grey("a")).unwrap();
+    let d = s.diagonal();
+    assert!((d / 1e20 - 1.0).abs() < 1e-6, "diagonal {d}");
+    let m = igi_core::settings::default_min_dist(&s);
+    assert!((m / 5e18 - 1.0).abs() < 1e-6, "min_dist {m}");
+}
+
+#[test]
+fn vectors_of_the_wrong_length_are_refused() {
+    for (i, (from, to, key)) in [
+        (
+            "eye = [0.0, 0.0, 5.0]",
+            "eye = [0.0, 1.0, 3.9, 1.0]",
+            "camera.eye",
+        ),
+        (
+            "up = [0.0, 1.0, 0.0]",
+            "up = [0.0, 1.0, 0.0, \"x\"]",
+            "camera.up",
+        ),
+        (
+            "intensity = [1.0, 1.0, 1.0]",
+            "intensity = [1.0, 1.0, 1.0, 9.0]",
+            "point_light.intensity",
+        ),
+        (
+            "diffuse = [0.5, 0.5, 0.5]",
+            "diffuse = [0.5, 0.5, 0.5, 0.5, 0.5]",
+            "materials.a.diffuse",
+        ),
+        ("eye = [0.0, 0.0, 5.0]", "eye = [0.0, 5.0]", "camera.eye"),
+        ("eye = [0.0, 0.0, 5.0]", "eye = []", "camera.eye"),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        bad_toml(
+            &format!("len{i}"),
+            from,
+            to,
+            true,
+            &[key, "expected 3 numbers"],
+        );
+    }
+}
+
+#[test]
+fn values_beyond_f32_are_reported_as_written() {
+    let msg = bad_toml(
+        "eye-1e300",
+        "eye = [0.0, 0.0, 5.0]",
+        "eye = [1e300, 1.0, 3.9]",
+        true,
+        &["camera.eye", "1e300", "out of range for 32-bit floats"],
+    );
+    assert!(!msg.contains("inf"), "{msg}");
+    let msg = bad_toml(
+        "fov-1e300",
+        "fov_y_deg = 40.0",
+        "fov_y_deg = 1e300",
+        true,
+        &["camera.fov_y_deg = 1e300"],
+    );
+    assert!(!msg.contains("inf"), "{msg}");
+}
+
+#[test]
+fn trailing_comments_on_every_obj_and_mtl_line() {
+    let dir = TestDir::new("comments");
+    dir.write(
+        "m.mtl",
+        "# library\nnewmtl red # the red one\nKd 0.5 0 0 # albedo\nillum 2 # no mirror\nnewmtl Mat#2\nKd 0.1 0.2 0.3\n",
+    );
+    dir.write(
+        "m.obj",
+        "mtllib m.mtl # materials\nv 0 0 0 # a\nv 1 0 0 #b\nv 0 1 0\nvn 0 0 1 # up\nusemtl red # paint\nf 1//1 2//1 3//1 # face\nusemtl Mat#2\nf 3 2 1 #\n",
+    );
+    let s = dir
+        .load(&scene_toml(&mesh("m.obj"), ""))
+        .expect("comments are ignored");
+    assert_eq!(s.triangles.len(), 2);
+    let names: Vec<&str> = s.materials.iter().map(|m| m.name.as_str()).collect();
+    assert_eq!(names, ["red", "Mat#2"]);
+    assert_eq!(s.materials[0].diffuse, Vec3::new(0.5, 0.0, 0.0));
+    // Line numbers still count the comment lines.
+    let obj = "v 0 0 0 # a\nv 1 0 0\n# c\nf 1 2 9 # bad\n";
+    expect_err(
+        load_obj("comment-line", obj, &grey("a")),
+        "mesh.obj:4",
+        &["9"],
+    );
+}

@@ -185,6 +185,7 @@ impl Renderer {
         let range_layout = gather_range_layout(device);
         // One pass over the triangles for both figures of the scene's size.
         let (lo, hi) = scene.bounds();
+        warn_large_min_dist(scene, igi_core::scene::diagonal_of(lo, hi));
         let renderer = Renderer {
             vpl: VplPass::new(device, layout),
             direct: DirectPass::new(device, layout, &range_layout),
@@ -221,7 +222,7 @@ impl Renderer {
             camera: scene.camera,
             light_power_sum: light_powers(&scene.lights).0,
             total_power: light_powers(&scene.lights).1,
-            diagonal: (hi - lo).length(),
+            diagonal: igi_core::scene::diagonal_of(lo, hi),
             ray_offset_floor: igi_core::bvh::offset_floor(lo, hi),
             path_cache: None,
             counting: false,
@@ -1256,6 +1257,28 @@ impl Renderer {
             None,
         );
         stages
+    }
+}
+
+/// Warns when the default bounding distance of G (a fraction of the diagonal) is longer
+/// than every distance between the camera and what it looks at (its target, the lights):
+/// then far-away geometry (one triangle at 1e20 among a room's) has stretched the bounds,
+/// and G cuts off all the indirect light that matters. Only a warning: the default is
+/// still what the documentation says, and `--min-dist` overrides it.
+fn warn_large_min_dist(scene: &Scene, diagonal: f32) {
+    let m = igi_core::settings::DEFAULT_MIN_DIST_FRACTION * diagonal;
+    let eye = scene.camera.eye;
+    let reach = scene
+        .lights
+        .iter()
+        .map(|l| l.position.distance(eye))
+        .fold(scene.camera.target.distance(eye), f32::max);
+    if m > reach {
+        log::warn!(
+            "{}: the default min_dist {m:.4e} ({}% of the scene's diagonal {diagonal:.4e}) exceeds the camera's distance to its target and lights ({reach:.4e}): geometry far away stretches the bounds, and the bound of G removes the indirect light; set --min-dist",
+            scene.source,
+            igi_core::settings::DEFAULT_MIN_DIST_FRACTION * 100.0
+        );
     }
 }
 

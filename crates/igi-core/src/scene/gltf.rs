@@ -450,7 +450,7 @@ impl Warnings {
         );
         w(
             self.degenerate,
-            "degenerate triangles (zero or non-finite area) dropped",
+            "degenerate triangles (zero area, or a vertex made non-finite by its node transform) dropped",
         );
         w(
             self.bad_normals,
@@ -1028,13 +1028,11 @@ impl Reader {
                 ));
             }
             let v = local.map(|p| world.transform_point3(p));
-            let c = (v[1] - v[0]).cross(v[2] - v[0]);
-            let len = c.length();
-            if !(len > 0.0 && len.is_finite()) {
+            // A world transform may still make a vertex non-finite: then it is dropped too.
+            let Some(ng) = super::geometric_normal(&v) else {
                 self.warn.degenerate += 1;
                 continue;
-            }
-            let ng = c / len;
+            };
             let mut n = [ng; 3];
             if let Some(normals) = &normals {
                 for (k, nk) in n.iter_mut().enumerate() {

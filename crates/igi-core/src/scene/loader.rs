@@ -26,8 +26,15 @@
 //!   before its vertices) work within one object or group (a limit of tobj).
 //! - A face uses its `vn` normals only if every corner has one (otherwise the geometric
 //!   normal); `vn` of zero length fall back to the geometric normal.
-//! - Degenerate triangles (zero or non-finite area) are dropped with a warning; non-finite
-//!   vertex coordinates used by a face are an error.
+//! - Degenerate triangles (zero area, judged in f64 so that a large valid triangle whose
+//!   f32 cross product overflows is kept) are dropped with a warning; non-finite vertex
+//!   coordinates used by a face are an error.
+//! - A light may emit nothing (intensity 0); a light whose power 4 pi (r + g + b), or the
+//!   sum of all lights' power, is beyond f32 is an error (the renderer sums it in f32 to
+//!   choose lights; an infinite sum made every pixel NaN).
+//! - Vectors are exactly three numbers, each within the f32 range (quoted as written
+//!   otherwise). In OBJ and MTL files a `#` that starts a word starts a comment, on every
+//!   kind of line (`strip_comments`).
 //! - A TOML file must be UTF-8. In OBJ and MTL files a NUL byte is an error (binary data),
 //!   other bytes that are not UTF-8 (a Latin-1 comment) are replaced, with a warning.
 //!
@@ -67,6 +74,10 @@ pub const DEFAULT_FILM: Film = Film {
 
 /// `camera.up` when the scene file leaves it out.
 pub const DEFAULT_UP: Vec3 = Vec3::Y;
+
+/// Coordinates beyond which ray tests may overflow (2^62, ~4.6e18; an edge of 9e18 was
+/// already missed on lavapipe).
+const FAR_COORDINATE: f32 = 4.611686e18;
 
 /// Slack allowed on `diffuse + mirror <= 1` (per channel), for values written with few
 /// digits such as 0.35 + 0.65.
@@ -278,7 +289,53 @@ fn as_lenient_text<'a>(bytes: &'a [u8], file: &str) -> Result<Cow<'a, str>, Scen
 // The TOML document
 // ---------------------------------------------------------------------------------------
 
-type V3 = Spanned<[f32; 3]>;
+type V3 = Spanned<Num3>;
+
+/// `[x, y, z]` in the TOML: exactly three numbers, each within the range of f32. Serde's
+/// `[f32; 3]` reads three elements and ignores the rest (so `[0, 1, 3.9, 1]` passed), and
+/// turns a number beyond the f32 range into inf (so `1e300` was reported as `inf`).
+#[derive(Clone, Copy, Debug)]
+struct Num3([f32; 3]);
+
+impl<'de> Deserialize<'de> for Num3 {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Three;
+        impl<'de> serde::de::Visitor<'de> for Three {
+            type Value = Num3;
+
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("3 numbers")
+            }
+
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut seq: A) -> Result<Num3, A::Error> {
+                use serde::de::Error;
+                let mut v = [0.0f32; 3];
+                for (k, x) in v.iter_mut().enumerate() {
+                    let Some(y) = seq.next_element::<f64>()? else {
+                        return Err(A::Error::invalid_length(k, &self));
+                    };
+                    // NaN and inf pass: the checks of each key say what they must be.
+                    if y.is_finite() && y.abs() > f32::MAX as f64 {
+                        return Err(A::Error::custom(format!(
+                            "{y:e} is out of range for 32-bit floats (at most {:e} in magnitude)",
+                            f32::MAX
+                        )));
+                    }
+                    *x = y as f32;
+                }
+                let mut n = 3;
+                while seq.next_element::<serde::de::IgnoredAny>()?.is_some() {
+                    n += 1;
+                }
+                if n > 3 {
+                    return Err(A::Error::invalid_length(n, &self));
+                }
+                Ok(Num3(v))
+            }
+        }
+        d.deserialize_seq(Three)
+    }
+}
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -299,7 +356,8 @@ struct CameraDesc {
     eye: V3,
     target: V3,
     up: Option<V3>,
-    fov_y_deg: Spanned<f32>,
+    /// f64, so that a value beyond the f32 range is reported as written, not as inf.
+    fov_y_deg: Spanned<f64>,
 }
 
 #[derive(Deserialize)]
@@ -345,8 +403,13 @@ impl TomlFile<'_> {
         SceneError::invalid(self.at(span), message)
     }
 
+    /// A value as the file writes it (its span), for messages.
+    fn written(&self, span: Range<usize>) -> String {
+        excerpt(self.text.get(span).unwrap_or(""))
+    }
+
     fn finite(&self, v: &V3, key: &str) -> Result<Vec3, SceneError> {
-        let a = *v.get_ref();
+        let a = v.get_ref().0;
         if a.iter().all(|x| x.is_finite()) {
             Ok(Vec3::from(a))
         } else {
@@ -527,6 +590,7 @@ pub fn load_scene_str(toml_text: &str, base_dir: &Path, name: &str) -> Result<Sc
             "the scene has no [[point_light]] (and its glTF meshes no point light): at least one light is required",
         ));
     }
+    check_total_power(&lights, name)?;
 
     // Resolve every used slot to a material, once per name.
     let mut materials: Vec<Material> = Vec::new();
@@ -592,6 +656,17 @@ pub fn load_scene_str(toml_text: &str, base_dir: &Path, name: &str) -> Result<Sc
             "the scene has no triangles (its meshes have no faces, or only degenerate ones)",
         ));
     }
+    // Ray tests multiply coordinates (relative to the ray's origin) in f32: past ~1e19
+    // the products overflow and rays miss the triangle. Valid input, so kept, but said.
+    let far = triangles
+        .iter()
+        .filter(|t| t.v.iter().any(|p| p.abs().max_element() > FAR_COORDINATE))
+        .count();
+    if far > 0 {
+        log::warn!(
+            "{name}: {far} triangles have coordinates beyond {FAR_COORDINATE:e}: rays (32-bit floats) may miss them"
+        );
+    }
 
     Ok(Scene {
         camera,
@@ -620,6 +695,33 @@ fn toml_message(e: &toml::de::Error) -> String {
     }
 }
 
+/// The OBJ or MTL text without its comments: a `#` at the start of a line or after
+/// white space begins a comment to the end of the line (`f 1 2 3 # face`). Lines keep
+/// their numbers (the newlines stay). tobj skips only lines whose first word is `#`, so
+/// a trailing comment failed on `f` lines ("cannot read face index '#'"), became part of
+/// the name on `usemtl`/`newmtl` lines and a file name on `mtllib` lines, and passed on
+/// `v` lines only by chance. A `#` inside a word (`Material#2`) is kept: names use it.
+fn strip_comments(text: &str) -> Cow<'_, str> {
+    let bytes = text.as_bytes();
+    let mut out = String::new();
+    // text[..kept] is in `out` or was a comment.
+    let mut kept = 0;
+    let mut any = false;
+    for (i, _) in text.match_indices('#') {
+        if i < kept || (i > 0 && !bytes[i - 1].is_ascii_whitespace()) {
+            continue;
+        }
+        out.push_str(&text[kept..i]);
+        kept = text[i..].find('\n').map_or(text.len(), |n| i + n);
+        any = true;
+    }
+    if !any {
+        return Cow::Borrowed(text);
+    }
+    out.push_str(&text[kept..]);
+    Cow::Owned(out)
+}
+
 // ---------------------------------------------------------------------------------------
 // TOML validation
 // ---------------------------------------------------------------------------------------
@@ -633,11 +735,16 @@ fn camera(tf: &TomlFile, c: &Spanned<CameraDesc>) -> Result<Camera, SceneError> 
         None => DEFAULT_UP,
     };
     let up_span = d.up.as_ref().map_or(c.span(), |u| u.span());
-    let fov = *d.fov_y_deg.get_ref();
-    if !(fov > 0.0 && fov < 180.0) {
+    let fov64 = *d.fov_y_deg.get_ref();
+    let fov = fov64 as f32;
+    // Also in f32: a value just above 0 that rounds to 0.
+    if !(fov64 > 0.0 && fov64 < 180.0 && fov > 0.0 && fov < 180.0) {
         return Err(tf.invalid(
             d.fov_y_deg.span(),
-            format!("camera.fov_y_deg = {fov} must be between 0 and 180 degrees (exclusive)"),
+            format!(
+                "camera.fov_y_deg = {} must be between 0 and 180 degrees (exclusive)",
+                tf.written(d.fov_y_deg.span())
+            ),
         ));
     }
     // In f64: the basis must be well defined for any finite f32 input.
@@ -693,7 +800,7 @@ fn film(tf: &TomlFile, f: Option<&FilmDesc>) -> Result<Film, SceneError> {
 
 fn light(tf: &TomlFile, l: &LightDesc) -> Result<PointLight, SceneError> {
     let position = tf.finite(&l.position, "point_light.position")?;
-    let i = *l.intensity.get_ref();
+    let i = l.intensity.get_ref().0;
     if !i.iter().all(|x| x.is_finite() && *x >= 0.0) {
         return Err(tf.invalid(
             l.intensity.span(),
@@ -703,16 +810,52 @@ fn light(tf: &TomlFile, l: &LightDesc) -> Result<PointLight, SceneError> {
             ),
         ));
     }
+    let power = light_power_f64(Vec3::from(i));
+    if power > f32::MAX as f64 {
+        return Err(tf.invalid(
+            l.intensity.span(),
+            format!(
+                "point_light.intensity = {}: its power 4 pi (r + g + b) = {power:.3e} W is beyond the range of 32-bit floats ({:.3e}), in which the renderer sums the lights' power",
+                tf.written(l.intensity.span()),
+                f32::MAX
+            ),
+        ));
+    }
     Ok(PointLight {
         position,
         intensity: Vec3::from(i),
     })
 }
 
+/// A light's power summed over channels, 4 pi (r + g + b), in f64: the figure by which
+/// lights are chosen (vpl.wgsl sums it in f32, over all lights, so it must stay in range).
+fn light_power_f64(intensity: Vec3) -> f64 {
+    4.0 * std::f64::consts::PI * intensity.as_dvec3().element_sum()
+}
+
+/// Refuses lights whose summed power overflows f32: light choice on the GPU and CPU
+/// divides by that sum, and an infinite one made every VPL's flux NaN (a NaN image). A
+/// light that emits nothing is fine (it is never chosen); each TOML light was checked on
+/// its own in [`light`], this catches the sum and glTF lights.
+fn check_total_power(lights: &[PointLight], name: &str) -> Result<(), SceneError> {
+    let total: f64 = lights.iter().map(|l| light_power_f64(l.intensity)).sum();
+    if total > f32::MAX as f64 {
+        return Err(SceneError::invalid(
+            Location::file(name),
+            format!(
+                "the {} lights' total power 4 pi sum(r + g + b) = {total:.3e} W is beyond the range of 32-bit floats ({:.3e}), in which the renderer sums it: scale the intensities down",
+                lights.len(),
+                f32::MAX
+            ),
+        ));
+    }
+    Ok(())
+}
+
 fn check_toml_material(tf: &TomlFile, name: &str, m: &MaterialDesc) -> Result<(), SceneError> {
     for (v, key) in [(&m.diffuse, "diffuse"), (&m.mirror, "mirror")] {
         if let Some(v) = v {
-            let a = *v.get_ref();
+            let a = v.get_ref().0;
             if !a.iter().all(|x| (0.0..=1.0).contains(x)) {
                 return Err(tf.invalid(
                     v.span(),
@@ -787,7 +930,7 @@ fn resolve_material(
     let pick = |key: &str, toml_v: Option<&V3>, mtl_v: Option<([f32; 3], String)>| {
         if let Some(v) = toml_v {
             Sourced {
-                value: *v.get_ref(),
+                value: v.get_ref().0,
                 at: tf.at(v.span()),
                 what: format!("materials.{name}.{key}"),
                 from_toml: true,
@@ -918,6 +1061,7 @@ fn undefined_material(
 fn read_mtl(bytes: &[u8], path: &Path, table: &mut MtlTable) -> Result<(), SceneError> {
     let file = path.display().to_string();
     let text = as_lenient_text(bytes, &file)?;
+    let text = strip_comments(text.as_ref());
     let text = text.as_ref();
     let newmtl_lines = check_mtl(text, &file)?;
     let loaded = catch_unwind(AssertUnwindSafe(|| {
@@ -1324,6 +1468,7 @@ fn load_obj(
 ) -> Result<(), SceneError> {
     let file = path.display().to_string();
     let text = as_lenient_text(bytes, &file)?;
+    let text = strip_comments(text.as_ref());
     let text = text.as_ref();
     let scan = scan_obj(text, &file)?;
     if scan.small_faces > 0 {
@@ -1472,13 +1617,10 @@ fn load_obj(
             if !v.iter().all(|p| p.is_finite()) {
                 return Err(non_finite_vertex(text, &file));
             }
-            let c = (p1 - p0).cross(p2 - p0);
-            let len = c.length();
-            if !(len > 0.0 && len.is_finite()) {
+            let Some(ng) = super::geometric_normal(&v) else {
                 degenerate += 1;
                 continue;
-            }
-            let ng = c / len;
+            };
             let mut n = [ng; 3];
             if has_normals && flag & TRI_HAS_VN != 0 {
                 for (k, nk) in n.iter_mut().enumerate() {
@@ -1501,7 +1643,9 @@ fn load_obj(
         return Err(internal("fewer triangles than faces"));
     }
     if degenerate > 0 {
-        log::warn!("{file}: {degenerate} degenerate triangles (zero or non-finite area) dropped");
+        log::warn!(
+            "{file}: {degenerate} degenerate triangles (zero area, or edges beyond the 32-bit float range) dropped"
+        );
     }
     if bad_normals > 0 {
         log::warn!(

@@ -46,8 +46,12 @@ fn halton(dim_in: u32, index: u32) -> f32 {
 
 const SHOOT_GROUP: u32 = 64u;
 
+// No light chosen: none emits.
+const NO_LIGHT: u32 = 0xffffffffu;
+
+// Clamped: shoot_path asks for NO_LIGHT's weight too (and then shoots nothing).
 fn light_power_weight(l: u32) -> f32 {
-    let i = lights[l].intensity;
+    let i = lights[min(l, params.light_count - 1u)].intensity;
     return 4.0 * PI * (i.x + i.y + i.z);
 }
 
@@ -67,17 +71,22 @@ fn shoot_path(path: u32) -> u32 {
 
     // Light choice in proportion to power: flux = Phi_l / (p_l M) = total / M for grey
     // lights, and exact per channel for coloured ones.
+    // A light of zero power is never chosen, not even when rounding runs u past the
+    // last weight (then the last light that emits is): its p_light of 0 made the flux
+    // 0 / 0, NaN in every pixel. When no light emits, the path stores nothing.
     var u = halton(0u, index) * params.light_power_sum;
-    var chosen = params.light_count - 1u;
+    var chosen = NO_LIGHT;
     for (var l = 0u; l < params.light_count; l += 1u) {
         let w = light_power_weight(l);
-        if (u < w) {
+        if (w > 0.0) {
             chosen = l;
-            break;
+            if (u < w) {
+                break;
+            }
         }
         u -= w;
     }
-    let light = lights[chosen];
+    let light = lights[min(chosen, params.light_count - 1u)];
     let p_light = light_power_weight(chosen) / params.light_power_sum;
     var flux = 4.0 * PI * light.intensity / (p_light * f32(params.path_count));
 
@@ -86,7 +95,7 @@ fn shoot_path(path: u32) -> u32 {
     var stored = 0u;
     var dim = 3u;
     // Mirror reflections store nothing, so the walk is bounded separately.
-    let max_segments = params.bounces + params.mirror_depth;
+    let max_segments = select(params.bounces + params.mirror_depth, 0u, chosen == NO_LIGHT);
     var stack: WalkStack;
     var traced = 0u;
     for (var segment = 0u; segment < max_segments; segment += 1u) {
