@@ -7,6 +7,7 @@
 
 use std::io::BufWriter;
 use std::path::{Path, PathBuf};
+use std::sync::{Mutex, MutexGuard};
 
 /// A linear RGB image, rows top to bottom.
 #[derive(Clone, Debug, PartialEq)]
@@ -22,6 +23,10 @@ pub enum ImageError {
     Write { path: PathBuf, reason: String },
     #[error("cannot read '{path}': {reason}")]
     Read { path: PathBuf, reason: String },
+    /// A file of another kind where OpenEXR was expected: the decoder's own words for it
+    /// ("file identifier missing", "reference to missing bytes") do not say so.
+    #[error("'{path}' is not an OpenEXR file ({reason})")]
+    NotExr { path: PathBuf, reason: String },
     #[error("image sizes differ: {0}x{1} against {2}x{3}")]
     SizeMismatch(u32, u32, u32, u32),
 }
@@ -86,29 +91,53 @@ impl Image {
     }
 
     /// Read the first RGB(A) layer of an OpenEXR file (half or float) as linear RGB.
+    /// A FIFO or device is refused, not read (which could block forever).
     pub fn read_exr(path: &Path) -> Result<Image, ImageError> {
-        let image = exr::prelude::read_first_rgba_layer_from_file(
-            path,
-            |size, _| Self::new(size.0 as u32, size.1 as u32),
-            |img: &mut Self, pos, (r, g, b, _a): (f32, f32, f32, f32)| {
-                let i = pos.1 * img.width as usize + pos.0;
-                img.data[i] = [r, g, b];
-            },
-        )
-        .map_err(|e| ImageError::Read {
+        let err = |reason: String| ImageError::Read {
             path: path.to_path_buf(),
-            reason: e.to_string(),
-        })?;
+            reason,
+        };
+        use exr::prelude::{ReadChannels, ReadLayers};
+        let bytes =
+            crate::scene::loader::read_regular_file(path).map_err(|e| err(e.to_string()))?;
+        let not_exr = not_exr_reason(&bytes);
+        let image = exr::prelude::read()
+            .no_deep_data()
+            .largest_resolution_level()
+            .rgba_channels(
+                |size, _| Self::new(size.0 as u32, size.1 as u32),
+                |img: &mut Self, pos, (r, g, b, _a): (f32, f32, f32, f32)| {
+                    let i = pos.1 * img.width as usize + pos.0;
+                    img.data[i] = [r, g, b];
+                },
+            )
+            .first_valid_layer()
+            .all_attributes()
+            .from_buffered(std::io::Cursor::new(bytes))
+            .map_err(|e| match not_exr {
+                Some(reason) => ImageError::NotExr {
+                    path: path.to_path_buf(),
+                    reason,
+                },
+                None => err(e.to_string()),
+            })?;
         Ok(image.layer_data.channel_data.pixels)
     }
 
     /// Write float32 RGB OpenEXR (linear radiance, no exposure).
     pub fn write_exr(&self, path: &Path) -> Result<(), ImageError> {
-        write_atomically(path, |tmp| {
-            exr::prelude::write_rgb_file(tmp, self.width as usize, self.height as usize, |x, y| {
+        use exr::prelude::{SpecificChannels, Vec2, WritableImage};
+        write_atomically(path, |file| {
+            let channels = SpecificChannels::rgb(|Vec2(x, y): Vec2<usize>| {
                 let p = self.data[y * self.width as usize + x];
                 (p[0], p[1], p[2])
-            })
+            });
+            exr::prelude::Image::from_channels(
+                (self.width as usize, self.height as usize),
+                channels,
+            )
+            .write()
+            .to_unbuffered(file)
             .map_err(|e| e.to_string())
         })
     }
@@ -116,8 +145,7 @@ impl Image {
     /// Write an 8-bit sRGB PNG of the image times `exposure` (clamped to [0, 1]).
     pub fn write_png(&self, path: &Path, exposure: f32) -> Result<(), ImageError> {
         let bytes = self.to_srgb8(exposure);
-        write_atomically(path, |tmp| {
-            let file = std::fs::File::create(tmp).map_err(|e| e.to_string())?;
+        write_atomically(path, |file| {
             let mut encoder = png::Encoder::new(BufWriter::new(file), self.width, self.height);
             encoder.set_color(png::ColorType::Rgb);
             encoder.set_depth(png::BitDepth::Eight);
@@ -134,6 +162,22 @@ impl Image {
             .iter()
             .flat_map(|p| p.map(|v| (linear_to_srgb(v * exposure) * 255.0 + 0.5) as u8))
             .collect()
+    }
+}
+
+/// Why `bytes` cannot be OpenEXR at all, or `None` where they begin as OpenEXR does (its
+/// magic number 76 2f 31 01).
+fn not_exr_reason(bytes: &[u8]) -> Option<String> {
+    const EXR: &[u8] = &[0x76, 0x2f, 0x31, 0x01];
+    const PNG: &[u8] = b"\x89PNG\r\n\x1a\n";
+    if bytes.starts_with(EXR) {
+        None
+    } else if bytes.is_empty() {
+        Some("the file is empty".into())
+    } else if bytes.starts_with(PNG) {
+        Some("it is a PNG image".into())
+    } else {
+        Some("it does not begin with the OpenEXR magic number".into())
     }
 }
 
@@ -174,46 +218,176 @@ pub fn rel_mse(image: &Image, reference: &Image) -> Result<f64, ImageError> {
     Ok(sum / (3 * image.data.len().max(1)) as f64)
 }
 
-/// Write through `write` to a temporary file beside `path`, then rename it into place. The
-/// directory is checked first so that a missing one gives a clear error.
+/// The file that writing `path` replaces: `path` with its symbolic links followed (the
+/// link stays and its target gets the new contents, as a shell's `>` does), in a
+/// directory named canonically, so that two names of one file compare equal. Errors,
+/// before anything is rendered or written, where no file could be put there: a missing
+/// directory, or an existing entry that is not a regular file (a FIFO or device must not
+/// be replaced by a rename, and a directory cannot be).
+pub fn output_target(path: &Path) -> Result<PathBuf, ImageError> {
+    let err = |reason: String| ImageError::Write {
+        path: path.to_path_buf(),
+        reason,
+    };
+    // A trailing '/' names a directory: the OS would say "Not a directory" of a file
+    // there, and without one the name would be written as a file.
+    if path.as_os_str().as_encoded_bytes().ends_with(b"/") {
+        return Err(err(
+            "that names a directory (it ends in '/'); give a file name".into(),
+        ));
+    }
+    let mut target = path.to_path_buf();
+    // Linux gives up on a chain of 40 links (ELOOP); so does this.
+    for _ in 0..40 {
+        match std::fs::symlink_metadata(&target) {
+            Ok(meta) if meta.file_type().is_symlink() => {
+                let link = std::fs::read_link(&target).map_err(|e| err(e.to_string()))?;
+                target = match target.parent() {
+                    Some(dir) => dir.join(link),
+                    None => link,
+                };
+            }
+            Ok(meta) if meta.is_dir() => {
+                return Err(err(
+                    "a directory, not a regular file: give a file name".into()
+                ))
+            }
+            Ok(meta) if !meta.is_file() => {
+                return Err(err(
+                    "not a regular file (a directory, device or pipe)".into()
+                ))
+            }
+            _ => {
+                let name = target
+                    .file_name()
+                    .ok_or_else(|| err("not a file name".into()))?;
+                let dir = match target.parent() {
+                    Some(d) if !d.as_os_str().is_empty() => d,
+                    _ => Path::new("."),
+                };
+                if dir.exists() && !dir.is_dir() {
+                    return Err(err(format!(
+                        "'{}' exists and is not a directory",
+                        dir.display()
+                    )));
+                }
+                if !dir.is_dir() {
+                    return Err(err(format!("directory '{}' does not exist", dir.display())));
+                }
+                let dir = dir.canonicalize().map_err(|e| err(e.to_string()))?;
+                return Ok(dir.join(name));
+            }
+        }
+    }
+    Err(err("too many levels of symbolic links".into()))
+}
+
+/// Temporary files being written now, so that a signal handler can remove them
+/// ([`remove_partial_files`]) before the process exits.
+static PARTIAL_FILES: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+fn partial_files() -> MutexGuard<'static, Vec<PathBuf>> {
+    // The list stays valid whatever a panicking holder did: each change is one push or
+    // one retain.
+    PARTIAL_FILES
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner)
+}
+
+/// Remove every temporary file [`write_atomically`] is writing, and keep any other from
+/// being created or renamed into place: for a handler of SIGINT or SIGTERM, which exits
+/// right after. Writers that get here later wait until the process is gone.
+pub fn remove_partial_files() {
+    let partial = partial_files();
+    for p in partial.iter() {
+        let _ = std::fs::remove_file(p);
+    }
+    // Held until the process exits: a writer neither creates a temporary file after the
+    // removal nor renames one that the removal missed.
+    std::mem::forget(partial);
+}
+
+/// Write through `write` to a temporary file beside the target of `path` (see
+/// [`output_target`], checked first), then rename it into place. `write` gets the file
+/// already open, so that a temporary file removed by [`remove_partial_files`] is never
+/// created again under its name.
 pub fn write_atomically(
     path: &Path,
-    write: impl FnOnce(&Path) -> Result<(), String>,
+    write: impl FnOnce(&mut std::fs::File) -> Result<(), String>,
 ) -> Result<(), ImageError> {
     let err = |reason: String| ImageError::Write {
         path: path.to_path_buf(),
         reason,
     };
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-        _ => PathBuf::from("."),
+    let target = output_target(path)?;
+    let (dir, name) = match (target.parent(), target.file_name()) {
+        (Some(dir), Some(name)) => (dir, name.to_string_lossy()),
+        _ => return Err(err("not a file name".into())),
     };
-    if !dir.is_dir() {
-        return Err(err(format!("directory '{}' does not exist", dir.display())));
-    }
-    let name = path
-        .file_name()
-        .ok_or_else(|| err("not a file name".into()))?
-        .to_string_lossy()
-        .to_string();
     // Keep the extension last: the EXR writer does not care, but tools looking at the
     // directory meanwhile see what kind of file it is.
     let tmp = dir.join(format!(".{name}.{}.partial", std::process::id()));
-    match write(&tmp) {
-        Ok(()) => std::fs::rename(&tmp, path).map_err(|e| {
-            let _ = std::fs::remove_file(&tmp);
-            err(e.to_string())
-        }),
-        Err(e) => {
-            let _ = std::fs::remove_file(&tmp);
-            Err(err(e))
-        }
+    let mut file = {
+        let mut partial = partial_files();
+        // Anything under this name was left by a dead process that had this id.
+        let _ = std::fs::remove_file(&tmp);
+        let file = std::fs::File::options()
+            .write(true)
+            .create_new(true)
+            .open(&tmp)
+            .map_err(|e| {
+                // The directory exists (output_target checked), so "not found" means it
+                // takes no new files (/proc, /sys): the OS's words alone would say that
+                // the output itself is missing.
+                err(match e.kind() {
+                    std::io::ErrorKind::NotFound => {
+                        format!("directory '{}' takes no new files", dir.display())
+                    }
+                    _ => format!("cannot create a file in '{}': {e}", dir.display()),
+                })
+            })?;
+        partial.push(tmp.clone());
+        file
+    };
+    let written = write(&mut file);
+    drop(file);
+    let mut partial = partial_files();
+    let result = written.and_then(|()| std::fs::rename(&tmp, &target).map_err(|e| e.to_string()));
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
     }
+    partial.retain(|p| p != &tmp);
+    result.map_err(err)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn files_of_other_kinds_are_not_openexr() {
+        let dir = std::env::temp_dir().join(format!("igi-not-exr-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let empty = dir.join("empty.exr");
+        std::fs::write(&empty, b"").unwrap();
+        let e = Image::read_exr(&empty).unwrap_err().to_string();
+        assert!(
+            e.contains("is not an OpenEXR file (the file is empty)"),
+            "{e}"
+        );
+        let png = dir.join("image.exr");
+        Image::new(2, 2).write_png(&png, 1.0).unwrap();
+        let e = Image::read_exr(&png).unwrap_err().to_string();
+        assert!(
+            e.contains("is not an OpenEXR file (it is a PNG image)"),
+            "{e}"
+        );
+        // A damaged OpenEXR file keeps the decoder's words.
+        std::fs::write(&empty, [0x76, 0x2f, 0x31, 0x01, 2]).unwrap();
+        let e = Image::read_exr(&empty).unwrap_err().to_string();
+        assert!(e.starts_with("cannot read"), "{e}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 
     #[test]
     fn rel_mse_known_values() {
@@ -268,5 +442,77 @@ mod tests {
         assert!((linear_to_srgb(1.0) - 1.0).abs() < 1e-6);
         assert!((linear_to_srgb(0.5) - 0.7354).abs() < 1e-3);
         assert_eq!(linear_to_srgb(f32::NAN), 0.0);
+    }
+
+    fn fresh_dir(name: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("igi-image-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        dir
+    }
+
+    fn mkfifo(path: &Path) {
+        let status = std::process::Command::new("mkfifo")
+            .arg(path)
+            .status()
+            .unwrap();
+        assert!(status.success());
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn writes_follow_links_and_refuse_what_is_not_a_regular_file() {
+        use std::os::unix::fs::FileTypeExt;
+        let dir = fresh_dir("targets");
+        let img = Image::new(2, 2);
+        // A link keeps being a link; its target gets the image.
+        std::fs::write(dir.join("target.exr"), "old").unwrap();
+        std::os::unix::fs::symlink("target.exr", dir.join("link.exr")).unwrap();
+        img.write_exr(&dir.join("link.exr")).unwrap();
+        let link = std::fs::symlink_metadata(dir.join("link.exr")).unwrap();
+        assert!(link.file_type().is_symlink());
+        assert_eq!(Image::read_exr(&dir.join("target.exr")).unwrap(), img);
+        assert_eq!(
+            output_target(&dir.join("link.exr")).unwrap(),
+            dir.canonicalize().unwrap().join("target.exr")
+        );
+        // A FIFO or a directory is neither replaced nor written.
+        mkfifo(&dir.join("fifo.png"));
+        std::fs::create_dir(dir.join("dir.png")).unwrap();
+        for name in ["fifo.png", "dir.png"] {
+            let e = img.write_png(&dir.join(name), 1.0).unwrap_err().to_string();
+            assert!(e.contains("not a regular file"), "{e}");
+        }
+        let fifo = std::fs::symlink_metadata(dir.join("fifo.png")).unwrap();
+        assert!(fifo.file_type().is_fifo());
+        assert!(dir.join("dir.png").is_dir());
+        let mut names: Vec<_> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().to_string())
+            .collect();
+        names.sort();
+        assert_eq!(names, ["dir.png", "fifo.png", "link.exr", "target.exr"]);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_fifo_is_refused_not_read_forever() {
+        let dir = fresh_dir("fifo-read");
+        let fifo = dir.join("in.exr");
+        mkfifo(&fifo);
+        // Reading a FIFO without a writer would block: the test ends either way.
+        let (tx, rx) = std::sync::mpsc::channel();
+        let path = fifo.clone();
+        std::thread::spawn(move || tx.send(Image::read_exr(&path).map_err(|e| e.to_string())));
+        let result = rx
+            .recv_timeout(std::time::Duration::from_secs(20))
+            .expect("read_exr blocked on a FIFO");
+        let e = result.unwrap_err();
+        assert!(
+            e.contains("in.exr") && e.contains("not a regular file"),
+            "{e}"
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

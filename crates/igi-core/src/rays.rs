@@ -69,16 +69,25 @@ pub enum RayFileError {
 /// Write rays in the documented format (through a temporary file and a rename).
 pub fn write_rays(path: &Path, rays: &[RayRecord]) -> Result<(), RayFileError> {
     let bytes: &[u8] = bytemuck::cast_slice(rays);
-    crate::image::write_atomically(path, |tmp| {
-        std::fs::write(tmp, bytes).map_err(|e| e.to_string())
+    crate::image::write_atomically(path, |file| {
+        std::io::Write::write_all(file, bytes).map_err(|e| e.to_string())
     })
-    .map_err(|e| RayFileError::Write(path.display().to_string(), e.to_string()))
+    .map_err(|e| {
+        // The image writer's error names the path too: keep its reason alone.
+        let reason = match e {
+            crate::image::ImageError::Write { reason, .. } => reason,
+            other => other.to_string(),
+        };
+        RayFileError::Write(path.display().to_string(), reason)
+    })
 }
 
 /// Read and check a ray file.
 pub fn read_rays(path: &Path) -> Result<Vec<RayRecord>, RayFileError> {
     let name = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|e| RayFileError::Read(name.clone(), e.to_string()))?;
+    // A FIFO or device is refused, not read (which could block forever).
+    let bytes = crate::scene::loader::read_regular_file(path)
+        .map_err(|e| RayFileError::Read(name.clone(), e.to_string()))?;
     if bytes.len() % 32 != 0 {
         return Err(RayFileError::Size(name, bytes.len() as u64));
     }
@@ -113,6 +122,32 @@ pub fn read_rays(path: &Path) -> Result<Vec<RayRecord>, RayFileError> {
         }
     }
     Ok(rays)
+}
+
+/// The most rays [`random_segments`] and [`random_rays`] make at once (and `igi bench
+/// rays` traces): 8 GiB of rays, which are generated, held and uploaded whole, with their
+/// results beside them; more would run out of host or GPU memory on any current machine.
+pub const MAX_RAYS: usize = 1 << 28;
+
+/// Whether a ray set of `count` rays can be made here: at most [`MAX_RAYS`], and the host
+/// memory for generating it (the surface points and the rays) can be had now. The reason
+/// otherwise, so that a huge count is one clear error instead of an aborted allocation.
+pub fn check_ray_count(count: usize) -> Result<(), String> {
+    if count > MAX_RAYS {
+        return Err(format!(
+            "at most {MAX_RAYS} rays ({} GiB of rays at 32 bytes a ray)",
+            (MAX_RAYS * 32) >> 30
+        ));
+    }
+    // Two sets of surface points (position and normal, 24 bytes each) and the rays.
+    let bytes = count * (2 * 24 + 32);
+    let mut probe: Vec<u8> = Vec::new();
+    probe.try_reserve_exact(bytes).map_err(|_| {
+        format!(
+            "cannot allocate the {} MiB that {count} rays need here",
+            bytes >> 20
+        )
+    })
 }
 
 /// A small deterministic generator (hash of a counter) for ray sets.
@@ -221,6 +256,45 @@ mod tests {
             .contains("multiple of 32"));
         std::fs::write(&path, []).unwrap();
         assert!(read_rays(&path).is_err());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn huge_counts_are_refused_before_allocating() {
+        assert!(check_ray_count(1 << 20).is_ok());
+        assert!(check_ray_count(MAX_RAYS).is_ok() || cfg!(target_pointer_width = "32"));
+        let e = check_ray_count(u32::MAX as usize).unwrap_err();
+        assert!(e.contains(&format!("at most {MAX_RAYS} rays")), "{e}");
+        assert!(check_ray_count(usize::MAX).is_err());
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_ray_file_that_is_not_a_regular_file_is_refused_and_said_once() {
+        let dir = std::env::temp_dir().join(format!("igi-rays-special-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        let fifo = dir.join("rays.bin");
+        let status = std::process::Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .unwrap();
+        assert!(status.success());
+        let (tx, rx) = std::sync::mpsc::channel();
+        let path = fifo.clone();
+        std::thread::spawn(move || tx.send(read_rays(&path).map_err(|e| e.to_string())));
+        let e = rx
+            .recv_timeout(std::time::Duration::from_secs(20))
+            .expect("read_rays blocked on a FIFO")
+            .unwrap_err();
+        assert!(e.contains("not a regular file"), "{e}");
+        // Writing where a directory is: the path named once.
+        let e = write_rays(&dir, &[RayRecord::default()])
+            .unwrap_err()
+            .to_string();
+        let name = format!("'{}'", dir.display());
+        assert_eq!(e.matches(&name).count(), 1, "{e}");
+        assert!(e.contains("not a regular file"), "{e}");
         std::fs::remove_dir_all(&dir).unwrap();
     }
 

@@ -42,6 +42,21 @@ fn out_of_memory_message(what: &str, bytes: Option<u64>, hint: &str) -> String {
 /// even for long shadow rays through the 277K-triangle conference room.
 pub const SOFTWARE_VPLS_PER_DISPATCH: u32 = 8;
 
+/// The most storage buffers one pipeline of igi binds (the direct pass's; a test counts
+/// them in the shaders). wgpu's GL backend offers fewer on some drivers (llvmpipe: 16).
+pub const STORAGE_BUFFERS_PER_STAGE: u32 = 19;
+
+/// Why igi cannot run on `adapter`, or `None` where it can: said when the device is
+/// opened, before a pipeline fails with a multi-line validation dump, and by `igi info`.
+fn shortfall(adapter: &wgpu::Adapter) -> Option<String> {
+    let allowed = adapter.limits().max_storage_buffers_per_shader_stage;
+    (allowed < STORAGE_BUFFERS_PER_STAGE).then(|| {
+        format!(
+            "allows {allowed} storage buffers per shader stage; igi needs {STORAGE_BUFFERS_PER_STAGE}"
+        )
+    })
+}
+
 /// Which adapter to use: the best one, or one named by index or by part of its name.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub enum AdapterChoice {
@@ -69,6 +84,8 @@ pub struct AdapterSummary {
     pub device_type: String,
     pub driver: String,
     pub timestamps: bool,
+    /// Why igi cannot run on it, if it cannot (too few storage buffers per stage).
+    pub unusable: Option<String>,
 }
 
 /// The device in use, with what igi needs to know about it.
@@ -140,6 +157,7 @@ pub fn list_adapters() -> (Vec<AdapterSummary>, Option<usize>) {
                     .trim()
                     .to_string(),
                 timestamps: a.features().contains(wgpu::Features::TIMESTAMP_QUERY),
+                unusable: shortfall(a),
             }
         })
         .collect();
@@ -152,8 +170,12 @@ fn pick(adapters: &[wgpu::Adapter], choice: &AdapterChoice) -> Result<usize, Gpu
         return Err(GpuError::NoAdapter);
     }
     match choice {
+        // An adapter igi can run on beats any it cannot.
         AdapterChoice::Best => Ok((0..adapters.len())
-            .max_by_key(|&i| (preference(&adapters[i].get_info()), usize::MAX - i))
+            .max_by_key(|&i| {
+                let usable = shortfall(&adapters[i]).is_none();
+                (usable, preference(&adapters[i].get_info()), usize::MAX - i)
+            })
             .expect("non-empty")),
         AdapterChoice::Named(name) => {
             if let Ok(i) = name.parse::<usize>() {
@@ -205,6 +227,12 @@ impl GpuContext {
 
     fn open(adapter: wgpu::Adapter) -> Result<GpuContext, GpuError> {
         let info = adapter.get_info();
+        if let Some(why) = shortfall(&adapter) {
+            return Err(GpuError::Limit(format!(
+                "adapter '{}' ({:?}) {why}: choose a Vulkan, Metal or DX12 adapter (igi info lists them)",
+                info.name, info.backend
+            )));
+        }
         let timestamps = adapter.features().contains(wgpu::Features::TIMESTAMP_QUERY);
         let mut features = wgpu::Features::empty();
         if timestamps {

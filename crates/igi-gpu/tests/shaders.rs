@@ -45,6 +45,32 @@ fn every_pass_shader_validates() {
     }
 }
 
+/// The storage buffers of the pass that declares the most, which is what a device must
+/// allow per shader stage: `GpuContext` refuses an adapter with fewer up front, by the
+/// number it is told, so that number must be the shaders' own.
+#[test]
+fn storage_buffers_per_stage_is_what_the_shaders_declare() {
+    let most = igi_gpu::passes::SOURCES
+        .iter()
+        .map(|pass| {
+            let module = naga::front::wgsl::parse_str(&igi_gpu::shader::compose(pass)).unwrap();
+            let storage = module
+                .global_variables
+                .iter()
+                .filter(|(_, g)| matches!(g.space, naga::AddressSpace::Storage { .. }))
+                .count() as u32;
+            (storage, pass.name)
+        })
+        .max()
+        .unwrap();
+    assert_eq!(
+        most.0,
+        igi_gpu::context::STORAGE_BUFFERS_PER_STAGE,
+        "the {} pass declares the most storage buffers",
+        most.1
+    );
+}
+
 /// (size, [(member name, offset)]) of the WGSL struct `name`.
 fn wgsl_layout(module: &naga::Module, name: &str) -> (u32, Vec<(String, u32)>) {
     let mut layouter = naga::proc::Layouter::default();

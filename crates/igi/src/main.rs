@@ -107,8 +107,14 @@ struct RaysArgs {
     /// Save the generated rays (with a single --kind).
     #[arg(long, value_name = "FILE", conflicts_with = "load")]
     save: Option<PathBuf>,
-    /// Trace rays from a file instead of generating them.
-    #[arg(long, value_name = "FILE")]
+    /// Trace rays from a file instead of generating them (the file fixes the rays, so the
+    /// options that generate them are refused with it).
+    // Clap counts only options given on the command line as conflicts, not defaults.
+    #[arg(
+        long,
+        value_name = "FILE",
+        conflicts_with_all = ["count", "set", "vpls", "width", "height", "seed"]
+    )]
     load: Option<PathBuf>,
     /// Timed runs after one warm-up; the median is reported.
     #[arg(long, default_value_t = 10)]
@@ -279,7 +285,8 @@ struct FrameArgs {
 #[derive(Args, Clone)]
 struct AccelArgs {
     /// A set-up by name, as in the paper's table: canonical, or iv, ds, il (and irregular,
-    /// fused) joined by '+', e.g. iv+ds+il. The options below adjust it.
+    /// which needs il, and fused, which needs ds or il) joined by '+', e.g. iv+ds+il. The
+    /// options below adjust it.
     #[arg(long, value_name = "NAME")]
     setup: Option<String>,
     /// VPL shadow rays test triangle bounding boxes instead of triangles.
@@ -288,13 +295,15 @@ struct AccelArgs {
     /// Indirect light at 1/S of the resolution per axis, then joint bilateral upsampling.
     #[arg(long, value_name = "S")]
     downsample: Option<u32>,
-    /// Interleaved sampling over NxM VPL subsets, then the discontinuity buffer (e.g. 3x3).
+    /// Interleaved sampling over NxM VPL subsets (N x M at most 64), then the discontinuity
+    /// buffer (e.g. 3x3).
     #[arg(long, value_name = "NxM", value_parser = parse_interleave)]
     interleave: Option<(u32, u32)>,
-    /// How subsets are laid out in a tile.
+    /// How subsets are laid out in a tile (irregular needs interleaving).
     #[arg(long, value_enum)]
     pattern: Option<PatternArg>,
-    /// Discontinuity buffer and upsampling as two passes, or fused in one.
+    /// Discontinuity buffer and upsampling as two passes, or fused in one (fused needs
+    /// downsampling or interleaving).
     #[arg(long, value_enum)]
     filter: Option<FilterArg>,
     /// Spatial sigma of the upsampler, in low-resolution pixels.
@@ -334,14 +343,23 @@ fn parse_interleave(s: &str) -> Result<(u32, u32), String> {
         .split_once(['x', 'X'])
         .ok_or_else(|| format!("'{s}' is not NxM (e.g. 3x3)"))?;
     let parse = |v: &str| {
-        v.trim()
-            .parse::<u32>()
-            .map_err(|_| format!("'{s}' is not NxM (e.g. 3x3)"))
+        let v = v.trim();
+        v.parse::<u32>().map_err(|e| match e.kind() {
+            std::num::IntErrorKind::PosOverflow => {
+                format!("{v} is too large: N x M must be at most 64 subsets")
+            }
+            _ => format!("'{s}' is not NxM (e.g. 3x3)"),
+        })
     };
     let (n, m) = (parse(n)?, parse(m)?);
-    if n == 0 || m == 0 || n * m > 64 {
+    if n == 0 || m == 0 {
+        return Err(format!("{n}x{m}: each side must be at least 1"));
+    }
+    // In u64: a product of two u32 sides can wrap around to a small number.
+    let subsets = u64::from(n) * u64::from(m);
+    if subsets > 64 {
         return Err(format!(
-            "interleave {n}x{m}: sides of at least 1 and at most 64 subsets"
+            "{n}x{m} is {subsets} subsets: N x M must be at most 64"
         ));
     }
     Ok((n, m))
@@ -350,7 +368,9 @@ fn parse_interleave(s: &str) -> Result<(u32, u32), String> {
 impl AccelArgs {
     fn accelerations(&self) -> Result<Accelerations> {
         let mut a = match &self.setup {
-            Some(name) => Accelerations::from_setup(name).map_err(anyhow::Error::msg)?,
+            Some(name) => {
+                Accelerations::from_setup(name).map_err(|e| anyhow::anyhow!("--setup: {e}"))?
+            }
             None => Accelerations::default(),
         };
         if self.imperfect_visibility {
@@ -406,7 +426,23 @@ impl AccelArgs {
             }
             a.normal_threshold = v;
         }
-        Ok(a)
+        // A set-up name was checked whole by from_setup, so an idle modifier here came
+        // from --pattern or --filter, or the options switched its acceleration off.
+        let named = |option: &str, given: bool| match (&self.setup, given) {
+            (Some(setup), false) => format!("{option} (from --setup {setup})"),
+            _ => option.to_string(),
+        };
+        match a.idle_modifier() {
+            Some("irregular") => bail!(
+                "{} lays out interleaved VPL subsets: it needs --interleave NxM (or il in --setup)",
+                named("--pattern irregular", self.pattern.is_some())
+            ),
+            Some(_) => bail!(
+                "{} runs the filters of downsampling and interleaving in one pass: it needs --downsample S or --interleave NxM (or ds or il in --setup)",
+                named("--filter fused", self.filter.is_some())
+            ),
+            None => Ok(a),
+        }
     }
 }
 
@@ -517,15 +553,36 @@ fn view(args: &ViewArgs) -> Result<()> {
             bail!("--screenshot: directory {} does not exist", dir.display());
         }
     }
+    if let Some(path) = &args.screenshot {
+        // The PNG's name: the EXR goes beside it, with the extension .exr.
+        let png = igi::outputs::Output {
+            option: "--screenshot",
+            path,
+            format: igi::outputs::Format::Png,
+            other: "the EXR is written beside the PNG",
+        };
+        igi::outputs::check(&[png], &[])?;
+    }
     let camera = match &args.camera {
         None => None,
         Some(text) => {
             let path = std::path::Path::new(text);
             let (text, name) = if !text.contains('=') {
-                let bytes = igi_core::scene::loader::read_regular_file(path)
-                    .with_context(|| format!("--camera {}", path.display()))?;
-                let text = String::from_utf8(bytes)
-                    .map_err(|_| anyhow::anyhow!("--camera {}: not UTF-8 text", path.display()))?;
+                // Text without '=' is taken for a file name, so a missing file may as
+                // well be mistyped TOML: the message says what either form looks like.
+                let bytes = igi_core::scene::loader::read_regular_file(path).map_err(|e| {
+                    if e.kind() == std::io::ErrorKind::NotFound {
+                        anyhow::anyhow!(
+                            "--camera '{}': no such file (give a TOML file with a [camera] table, or that TOML itself: eye = [...] ...)",
+                            path.display()
+                        )
+                    } else {
+                        anyhow::Error::new(e).context(format!("--camera '{}'", path.display()))
+                    }
+                })?;
+                let text = String::from_utf8(bytes).map_err(|_| {
+                    anyhow::anyhow!("--camera '{}': not UTF-8 text", path.display())
+                })?;
                 (text, path.display().to_string())
             } else {
                 (text.clone(), "--camera".to_string())
@@ -585,6 +642,9 @@ fn settings(scene: &Scene, f: &FrameArgs) -> Result<RenderSettings> {
     if f.bounces == 0 {
         bail!("--bounces must be at least 1");
     }
+    if f.accel.accumulate == 0 {
+        bail!("--accumulate must be at least 1");
+    }
     if let Some(m) = f.min_dist {
         if !(m.is_finite() && m > 0.0) {
             bail!("--min-dist must be a positive number, got {m}");
@@ -603,9 +663,28 @@ fn settings(scene: &Scene, f: &FrameArgs) -> Result<RenderSettings> {
         mirror_depth: f.mirror_depth,
         seed: f.seed,
         accelerations: f.accel.accelerations()?,
-        accumulate: f.accel.accumulate.max(1),
+        accumulate: f.accel.accumulate,
         ..RenderSettings::default()
     })
+}
+
+/// Every output of `igi render` checked before anything is rendered (see igi::outputs).
+fn check_render_outputs(args: &RenderArgs, scene: &Scene) -> Result<()> {
+    use igi::outputs::{Format, Output};
+    let png = args.output.as_deref().map(|path| Output {
+        option: "-o",
+        path,
+        format: Format::Png,
+        other: "write EXR with --exr",
+    });
+    let exr = args.exr.as_deref().map(|path| Output {
+        option: "--exr",
+        path,
+        format: Format::Exr,
+        other: "write PNG with -o",
+    });
+    let outputs: Vec<Output> = png.into_iter().chain(exr).collect();
+    igi::outputs::check(&outputs, &scene.files)
 }
 
 fn render(args: &RenderArgs) -> Result<()> {
@@ -622,6 +701,7 @@ fn render(args: &RenderArgs) -> Result<()> {
     let scene = load(&args.scene)?;
     let load_ms = t.elapsed().as_secs_f64() * 1e3;
     let mut settings = settings(&scene, &args.frame)?;
+    check_render_outputs(args, &scene)?;
     settings.exposure = args.exposure;
     settings.output = output_buffer(args.buffer);
     let t = Instant::now();
@@ -687,6 +767,9 @@ fn info() -> Result<()> {
             if a.driver.is_empty() { "?" } else { &a.driver },
             if a.timestamps { "yes" } else { "no" }
         );
+        if let Some(why) = &a.unusable {
+            println!("     unusable: it {why}");
+        }
     }
     if let Some(i) = best {
         println!("igi would use adapter {i} (marked *); choose another with --adapter INDEX|NAME");
@@ -727,6 +810,15 @@ fn bench_rays(args: &RaysArgs) -> Result<()> {
     use igi_gpu::raybench::{coherent_fraction, refill_offered, RayBench, RayQuery, RaySchedule};
     if args.count == 0 {
         bail!("--count must be at least 1");
+    }
+    // Before any allocation: a huge count would abort on it instead.
+    igi_core::rays::check_ray_count(args.count)
+        .map_err(|why| anyhow::anyhow!("--count {}: {why}", args.count))?;
+    if args.runs == 0 {
+        bail!("--runs must be at least 1");
+    }
+    if args.vpls == 0 {
+        bail!("--vpls must be at least 1");
     }
     if args.save.is_some() && args.kind == RayKindArg::Both {
         bail!("--save writes one ray set: give --kind shadow or --kind closest");
@@ -813,7 +905,7 @@ fn bench_rays(args: &RaysArgs) -> Result<()> {
             };
             eprintln!("any-hit schedule: {} ({why})", schedule.name());
         }
-        let timing = bench.trace(&ctx, &rays, query, schedule, args.runs.max(1))?;
+        let timing = bench.trace(&ctx, &rays, query, schedule, args.runs)?;
         let mut runs = timing.runs_ms.clone();
         runs.sort_by(f64::total_cmp);
         let median = runs[runs.len() / 2];
@@ -875,6 +967,11 @@ fn quiet_on_closed_pipes() {
 fn main() -> ExitCode {
     #[cfg(unix)]
     quiet_on_closed_pipes();
+    #[cfg(unix)]
+    if let Err(e) = igi::outputs::remove_partial_files_on_signals() {
+        eprintln!("error: cannot handle signals: {}", error_line(&e));
+        return ExitCode::FAILURE;
+    }
     env_logger::Builder::from_env(
         env_logger::Env::default()
             .default_filter_or("warn,wgpu_core=error,wgpu_hal=off,naga=error"),

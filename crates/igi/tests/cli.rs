@@ -569,3 +569,674 @@ fn closed_stdout_is_no_panic() {
         "exit code of a panic; stderr: {stderr}"
     );
 }
+
+/// The error line of `igi args` holds `text` exactly once (no "'foo' in 'foo'").
+fn said_once(out: &Output, text: &str) {
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(stderr.matches(text).count(), 1, "{stderr}");
+}
+
+#[test]
+fn setup_names_are_checked_naming_the_option_and_the_valid_names() {
+    let d = temp_dir("setups");
+    let png = d.join("x.png");
+    let out = igi(&[
+        "render",
+        "--builtin",
+        "cornell-box",
+        "--setup",
+        "foo",
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    assert_one_error_line(&out, &["--setup", "unknown set-up 'foo'", "iv, ds, il"]);
+    said_once(&out, "foo");
+    let bench = |setups: &str| {
+        let out_dir = d.join("bench-out");
+        igi(&[
+            "bench",
+            "builtin:cornell-box",
+            "--setups",
+            setups,
+            "--out",
+            out_dir.to_str().unwrap(),
+        ])
+    };
+    let out = bench("canonical,foo");
+    assert_one_error_line(&out, &["--setups", "unknown set-up 'foo'", "canonical"]);
+    said_once(&out, "foo");
+    // A trailing comma leaves an empty name: said as such, not as "unknown part ''".
+    let out = bench("canonical,");
+    assert_one_error_line(&out, &["--setups", "an empty set-up name", "iv, ds, il"]);
+    let out = bench("iv+");
+    assert_one_error_line(&out, &["--setups", "an empty part in set-up 'iv+'"]);
+    let out = bench("iv+foo");
+    assert_one_error_line(&out, &["unknown part 'foo' in set-up 'iv+foo'"]);
+    assert!(
+        !d.join("bench-out").exists(),
+        "nothing written on bad set-ups"
+    );
+}
+
+#[test]
+fn interleave_limits_state_the_real_rule() {
+    let run = |il: &str| {
+        igi(&[
+            "render",
+            "--builtin",
+            "cornell-box",
+            "--interleave",
+            il,
+            "-o",
+            "/tmp/igi-il.png",
+        ])
+    };
+    // Both sides under 64 but 72 subsets: the rule is on the product.
+    assert_one_error_line(
+        &run("9x8"),
+        &[
+            "--interleave",
+            "9x8 is 72 subsets",
+            "N x M must be at most 64",
+        ],
+    );
+    assert_one_error_line(
+        &run("99999999999x3"),
+        &["--interleave", "99999999999 is too large"],
+    );
+    // 65536 x 65536 wraps to 0 in 32 bits: refused, not taken for 1 subset.
+    assert_one_error_line(&run("65536x65536"), &["4294967296 subsets"]);
+    assert_one_error_line(&run("0x3"), &["each side must be at least 1"]);
+    assert_one_error_line(&run("3by3"), &["is not NxM"]);
+}
+
+#[test]
+fn zero_counts_are_refused_not_taken_for_one() {
+    let d = temp_dir("zero-counts");
+    let png = d.join("x.png");
+    let out = igi(&[
+        "render",
+        "--builtin",
+        "cornell-box",
+        "--accumulate",
+        "0",
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    assert_one_error_line(&out, &["--accumulate must be at least 1"]);
+    let rays = |extra: &[&str]| {
+        let mut args = vec!["bench", "rays", "builtin:cornell-box", "--count", "64"];
+        args.extend(extra);
+        igi(&args)
+    };
+    assert_one_error_line(&rays(&["--runs", "0"]), &["--runs must be at least 1"]);
+    // render refuses --vpls 0; so does the frame set of bench rays.
+    let out = rays(&["--set", "frame", "--kind", "shadow", "--vpls", "0"]);
+    assert_one_error_line(&out, &["--vpls must be at least 1"]);
+    assert!(!png.exists());
+}
+
+#[test]
+fn loaded_rays_refuse_the_options_that_generate_rays() {
+    let d = temp_dir("load-conflicts");
+    let file = d.join("rays.bin");
+    std::fs::write(&file, [0u8; 32]).unwrap();
+    for extra in [
+        ["--count", "16777216"],
+        ["--set", "random"],
+        ["--width", "8"],
+        ["--height", "8"],
+        ["--vpls", "30"],
+        ["--seed", "1"],
+    ] {
+        let mut args = vec![
+            "bench",
+            "rays",
+            "builtin:cornell-box",
+            "--load",
+            file.to_str().unwrap(),
+        ];
+        args.extend(extra);
+        let out = igi(&args);
+        assert_one_error_line(&out, &["--load", extra[0]]);
+    }
+}
+
+#[test]
+fn pattern_and_filter_need_the_acceleration_they_modify() {
+    let d = temp_dir("idle-modifiers");
+    let png = d.join("x.png");
+    let render = |extra: &[&str]| {
+        let mut args = vec![
+            "render",
+            "--builtin",
+            "cornell-box",
+            "-o",
+            png.to_str().unwrap(),
+        ];
+        args.extend(extra);
+        igi(&args)
+    };
+    let out = render(&["--pattern", "irregular"]);
+    assert_one_error_line(&out, &["--pattern irregular", "--interleave"]);
+    let out = render(&["--setup", "iv+ds", "--pattern", "irregular"]);
+    assert_one_error_line(&out, &["--pattern irregular", "--interleave"]);
+    let out = render(&["--filter", "fused"]);
+    assert_one_error_line(&out, &["--filter fused", "--downsample", "--interleave"]);
+    // Switched off again by an option: the modifier is left with nothing to modify.
+    let out = render(&["--setup", "il+fused", "--interleave", "1x1"]);
+    assert_one_error_line(&out, &["--filter fused (from --setup il+fused)"]);
+    // A set-up name is checked whole.
+    let out = render(&["--setup", "iv+irregular"]);
+    assert_one_error_line(
+        &out,
+        &["--setup", "set-up 'iv+irregular'", "irregular modifies il"],
+    );
+    let out = igi(&[
+        "bench",
+        "builtin:cornell-box",
+        "--setups",
+        "fused",
+        "--out",
+        d.join("b").to_str().unwrap(),
+    ]);
+    assert_one_error_line(&out, &["--setups", "fused modifies ds or il"]);
+    assert!(!png.exists());
+}
+
+#[test]
+fn compare_says_when_a_file_is_not_openexr() {
+    let d = temp_dir("not-exr");
+    let empty = d.join("empty.exr");
+    std::fs::write(&empty, b"").unwrap();
+    let png = d.join("picture.exr");
+    std::fs::write(&png, b"\x89PNG\r\n\x1a\n\0\0\0\rIHDR").unwrap();
+    for (file, why) in [(&empty, "the file is empty"), (&png, "it is a PNG image")] {
+        let f = file.to_str().unwrap();
+        let out = igi(&["compare", f, f]);
+        assert_one_error_line(&out, &[&format!("'{f}' is not an OpenEXR file ({why})")]);
+    }
+}
+
+#[test]
+fn adapters_with_too_few_storage_buffers_are_marked_and_refused() {
+    let info = igi(&["info"]);
+    let stdout = String::from_utf8_lossy(&info.stdout).to_string();
+    // "  1: NAME (Gl, ...)" followed by "     unusable: it allows ...".
+    let lines: Vec<&str> = stdout.lines().collect();
+    let unusable: Vec<String> = lines
+        .windows(2)
+        .filter(|w| w[1].trim_start().starts_with("unusable:"))
+        .filter_map(|w| {
+            let index = w[0].trim_start_matches(['*', ' ']).split(':').next()?;
+            Some(index.to_string())
+        })
+        .collect();
+    if unusable.is_empty() {
+        eprintln!("skipped: every adapter here has enough storage buffers ({stdout})");
+        return;
+    }
+    let d = temp_dir("unusable-adapter");
+    let png = d.join("x.png");
+    for index in &unusable {
+        let out = igi(&[
+            "render",
+            "--builtin",
+            "cornell-box",
+            "--width",
+            "16",
+            "--height",
+            "16",
+            "--adapter",
+            index,
+            "-o",
+            png.to_str().unwrap(),
+        ]);
+        assert_one_error_line(
+            &out,
+            &["storage buffers per shader stage", "igi needs", "igi info"],
+        );
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!stderr.contains("Validation Error"), "{stderr}");
+    }
+    // igi never picks one of them by itself.
+    assert!(!stdout.contains(&format!("use adapter {} ", unusable[0])));
+}
+
+// ---------------------------------------------------------------------------------------
+// Inputs that could block, outputs that could destroy, and what a failed or interrupted
+// run leaves behind.
+
+/// `igi args`, failing the test if it has not ended after `secs` (a run that blocks on a
+/// FIFO would otherwise hang the test suite).
+fn igi_in_time(args: &[&str], secs: u64) -> Output {
+    let mut child = common::igi_command()
+        .args(args)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("run igi");
+    let start = std::time::Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if start.elapsed().as_secs() > secs {
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!("igi {args:?} still running after {secs} s");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    child.wait_with_output().unwrap()
+}
+
+fn mkfifo(path: &Path) {
+    let status = Command::new("mkfifo").arg(path).status().expect("mkfifo");
+    assert!(status.success(), "mkfifo {}", path.display());
+}
+
+fn is_fifo(path: &Path) -> bool {
+    use std::os::unix::fs::FileTypeExt;
+    std::fs::symlink_metadata(path).is_ok_and(|m| m.file_type().is_fifo())
+}
+
+/// The names in `dir` (none of them a temporary `.partial` file).
+fn names_in(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().to_string())
+        .collect();
+    names.sort();
+    names
+}
+
+const TINY: [&str; 8] = [
+    "--builtin",
+    "cornell-box",
+    "--width",
+    "16",
+    "--height",
+    "16",
+    "--vpls",
+    "1",
+];
+
+fn render_tiny(extra: &[&str]) -> Output {
+    let mut args = vec!["render"];
+    args.extend(TINY);
+    args.extend(extra);
+    igi_in_time(&args, 120)
+}
+
+#[test]
+fn a_huge_ray_count_is_one_error_before_allocating() {
+    let out = igi_in_time(
+        &[
+            "bench",
+            "rays",
+            "builtin:cornell-box",
+            "--runs",
+            "1",
+            "--count",
+            "4294967295",
+        ],
+        60,
+    );
+    assert_one_error_line(&out, &["--count 4294967295", "at most 268435456 rays"]);
+}
+
+#[test]
+fn a_pipe_or_device_as_image_or_ray_file_is_refused_not_read_forever() {
+    let d = temp_dir("fifo-inputs");
+    let fifo = d.join("fifo.exr");
+    mkfifo(&fifo);
+    let other = d.join("other.exr");
+    let out = igi_in_time(
+        &["compare", fifo.to_str().unwrap(), other.to_str().unwrap()],
+        60,
+    );
+    assert_one_error_line(&out, &["fifo.exr", "not a regular file"]);
+    // bench's --reference reads the same way, before the GPU is asked for.
+    let bench_out = d.join("bench-out");
+    let out = igi_in_time(
+        &[
+            "bench",
+            "builtin:cornell-box",
+            "--reference",
+            fifo.to_str().unwrap(),
+            "--out",
+            bench_out.to_str().unwrap(),
+        ],
+        60,
+    );
+    assert_one_error_line(&out, &["fifo.exr", "not a regular file"]);
+    for load in [fifo.to_str().unwrap(), "/dev/zero"] {
+        let out = igi_in_time(
+            &[
+                "bench",
+                "rays",
+                "builtin:cornell-box",
+                "--runs",
+                "1",
+                "--kind",
+                "shadow",
+                "--load",
+                load,
+            ],
+            120,
+        );
+        if skipped_for_no_adapter(&out) {
+            return;
+        }
+        assert_one_error_line(&out, &[load, "not a regular file"]);
+    }
+}
+
+#[test]
+fn an_output_symlink_writes_its_target_and_stays_a_link() {
+    let d = temp_dir("out-link");
+    let target = write(&d, "target.png", "not yet an image");
+    let link = d.join("link.png");
+    std::os::unix::fs::symlink("target.png", &link).unwrap();
+    let out = render_tiny(&["-o", link.to_str().unwrap()]);
+    if skipped_for_no_adapter(&out) {
+        return;
+    }
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let meta = std::fs::symlink_metadata(&link).unwrap();
+    assert!(meta.file_type().is_symlink(), "the link was replaced");
+    assert!(std::fs::read(&target).unwrap().starts_with(b"\x89PNG"));
+    assert_eq!(names_in(&d), ["link.png", "target.png"]);
+}
+
+#[test]
+fn an_output_that_is_a_pipe_or_directory_is_refused_and_kept() {
+    let d = temp_dir("out-fifo");
+    let fifo = d.join("fifo.png");
+    mkfifo(&fifo);
+    let out = render_tiny(&["-o", fifo.to_str().unwrap()]);
+    assert_one_error_line(&out, &["fifo.png", "not a regular file"]);
+    assert!(is_fifo(&fifo), "the FIFO was replaced");
+    std::fs::create_dir(d.join("dir.exr")).unwrap();
+    let out = render_tiny(&["--exr", d.join("dir.exr").to_str().unwrap()]);
+    assert_one_error_line(&out, &["dir.exr", "not a regular file"]);
+    assert!(d.join("dir.exr").is_dir());
+    assert_eq!(names_in(&d), ["dir.exr", "fifo.png"]);
+}
+
+#[test]
+fn an_output_naming_an_input_or_another_output_is_refused() {
+    let d = temp_dir("out-input");
+    let scene = scene_with_obj(&d, QUAD);
+    let before = std::fs::read(&scene).unwrap();
+    let mesh = d.join("mesh.obj");
+    // The scene file and the mesh it names, also by another spelling of the path.
+    let other_spelling = d.join(".").join("mesh.obj");
+    for (option, path) in [
+        ("-o", scene.as_path()),
+        ("--exr", mesh.as_path()),
+        ("-o", other_spelling.as_path()),
+    ] {
+        let out = igi_in_time(
+            &[
+                "render",
+                scene.to_str().unwrap(),
+                option,
+                path.to_str().unwrap(),
+            ],
+            60,
+        );
+        assert_one_error_line(&out, &[option, "read from"]);
+    }
+    assert_eq!(std::fs::read(&scene).unwrap(), before);
+    assert_eq!(std::fs::read(&mesh).unwrap(), QUAD.as_bytes());
+    // No extension, which neither option would refuse alone.
+    let same = d.join("same");
+    let out = render_tiny(&[
+        "-o",
+        same.to_str().unwrap(),
+        "--exr",
+        same.to_str().unwrap(),
+    ]);
+    assert_one_error_line(&out, &["-o", "--exr", "same file"]);
+    assert!(!same.exists());
+}
+
+#[test]
+fn an_output_named_for_the_other_format_is_refused() {
+    let d = temp_dir("out-format");
+    let exr = d.join("out.exr");
+    let out = render_tiny(&["-o", exr.to_str().unwrap()]);
+    assert_one_error_line(&out, &["-o", "out.exr", "writes an sRGB PNG", "--exr"]);
+    let png = d.join("x.PNG");
+    let out = render_tiny(&["--exr", png.to_str().unwrap()]);
+    assert_one_error_line(&out, &["--exr", "x.PNG", "writes OpenEXR", "-o"]);
+    // The viewer's screenshot is the PNG; its EXR goes beside it.
+    let shot = d.join("shot.exr");
+    let out = igi_in_time(
+        &[
+            "view",
+            "--builtin",
+            "cornell-box",
+            "--frames",
+            "1",
+            "--screenshot",
+            shot.to_str().unwrap(),
+        ],
+        60,
+    );
+    assert_one_error_line(&out, &["--screenshot", "shot.exr", "PNG"]);
+    assert!(names_in(&d).is_empty());
+}
+
+#[test]
+fn a_bad_output_fails_the_run_before_any_output_is_written() {
+    let d = temp_dir("out-first");
+    let good = d.join("good.exr");
+    let missing = d.join("missing-dir/x.png");
+    let out = render_tiny(&[
+        "-o",
+        missing.to_str().unwrap(),
+        "--exr",
+        good.to_str().unwrap(),
+    ]);
+    assert_one_error_line(&out, &["missing-dir", "does not exist"]);
+    assert!(names_in(&d).is_empty(), "left {:?}", names_in(&d));
+}
+
+#[test]
+fn an_interrupted_render_leaves_no_temporary_file() {
+    use std::time::{Duration, Instant};
+    let d = temp_dir("interrupt");
+    let (exr, png) = (d.join("o.exr"), d.join("o.png"));
+    // A large image takes long enough to write that a signal can arrive meanwhile; each
+    // try watches for the temporary file and signals as soon as it appears. A render that
+    // ends first is tried again; none caught in all tries fails the test.
+    for signal in [libc::SIGINT, libc::SIGTERM] {
+        let mut caught = false;
+        for _ in 0..5 {
+            let mut child = common::igi_command()
+                .args(["render", "--builtin", "cornell-box", "--vpls", "1"])
+                .args(["--width", "2048", "--height", "2048"])
+                .args(["--exr", exr.to_str().unwrap(), "-o", png.to_str().unwrap()])
+                .stdout(std::process::Stdio::null())
+                .stderr(std::process::Stdio::piped())
+                .spawn()
+                .unwrap();
+            let start = Instant::now();
+            let mut seen = false;
+            while child.try_wait().unwrap().is_none() {
+                assert!(start.elapsed() < Duration::from_secs(300), "render hung");
+                if names_in(&d).iter().any(|n| n.ends_with(".partial")) {
+                    seen = true;
+                    // SAFETY: kill(2) on our own child's id, which it keeps until waited for.
+                    assert_eq!(unsafe { libc::kill(child.id() as i32, signal) }, 0);
+                    break;
+                }
+                std::thread::sleep(Duration::from_millis(1));
+            }
+            let out = child.wait_with_output().unwrap();
+            if skipped_for_no_adapter(&out) {
+                return;
+            }
+            let left = names_in(&d);
+            assert!(
+                !left.iter().any(|n| n.ends_with(".partial")),
+                "left {left:?} after signal {signal}"
+            );
+            if seen {
+                assert_eq!(
+                    out.status.code(),
+                    Some(128 + signal),
+                    "{}",
+                    String::from_utf8_lossy(&out.stderr)
+                );
+                caught = true;
+                break;
+            }
+            assert!(
+                out.status.success(),
+                "{}",
+                String::from_utf8_lossy(&out.stderr)
+            );
+            eprintln!("the render ended before a temporary file was seen; trying again");
+        }
+        assert!(
+            caught,
+            "no try was interrupted while writing (signal {signal})"
+        );
+    }
+}
+
+#[test]
+fn bench_makes_its_folder_only_after_its_inputs_and_outputs_are_checked() {
+    let d = temp_dir("bench-out-late");
+    let out_dir = d.join("out");
+    let not_exr = write(&d, "ref.exr", "not an EXR");
+    for bad in [
+        vec!["builtin:nope"],
+        vec!["builtin:cornell-box", "--width", "0"],
+        vec![
+            "builtin:cornell-box",
+            "--reference",
+            not_exr.to_str().unwrap(),
+        ],
+    ] {
+        let mut args = vec!["bench", "--quiet", "--frames", "1", "--warmup", "0"];
+        args.extend(["--vpls", "1", "--setups", "canonical"]);
+        args.extend(["--out", out_dir.to_str().unwrap()]);
+        args.extend(bad);
+        let out = igi_in_time(&args, 120);
+        if skipped_for_no_adapter(&out) {
+            return;
+        }
+        assert!(!out.status.success());
+        assert!(!out_dir.exists(), "{args:?} left {}", out_dir.display());
+    }
+    // A report's name taken by a directory fails the run before any image is written.
+    std::fs::create_dir_all(out_dir.join("results.md")).unwrap();
+    let out = igi_in_time(
+        &[
+            "bench",
+            "builtin:cornell-box",
+            "--quiet",
+            "--frames",
+            "1",
+            "--warmup",
+            "0",
+            "--vpls",
+            "1",
+            "--setups",
+            "canonical",
+            "--width",
+            "16",
+            "--height",
+            "16",
+            "--out",
+            out_dir.to_str().unwrap(),
+        ],
+        120,
+    );
+    assert_one_error_line(&out, &["results.md", "not a regular file"]);
+    assert_eq!(names_in(&out_dir), ["results.md"]);
+}
+
+#[test]
+fn a_ray_file_that_cannot_be_saved_is_said_once() {
+    let d = temp_dir("rays-save-dir");
+    let out = igi_in_time(
+        &[
+            "bench",
+            "rays",
+            "builtin:cornell-box",
+            "--runs",
+            "1",
+            "--count",
+            "64",
+            "--kind",
+            "shadow",
+            "--save",
+            d.to_str().unwrap(),
+        ],
+        120,
+    );
+    if skipped_for_no_adapter(&out) {
+        return;
+    }
+    assert_one_error_line(&out, &["cannot write ray file", "not a regular file"]);
+}
+
+#[test]
+fn output_paths_that_name_directories_say_so() {
+    let d = temp_dir("output-dirs");
+    let file = write(&d, "file", "");
+    let render = |out: &str| {
+        igi(&[
+            "render",
+            "--builtin",
+            "cornell-box",
+            "--width",
+            "16",
+            "--height",
+            "16",
+            "-o",
+            out,
+        ])
+    };
+    let dir = d.to_str().unwrap();
+    // Not the OS's "Not a directory" for an existing directory given with its '/'.
+    let out = render(&format!("{dir}/"));
+    assert_one_error_line(&out, &["names a directory", "give a file name"]);
+    let out = render(dir);
+    assert_one_error_line(&out, &["a directory, not a regular file"]);
+    let out = render(&format!("{}/x.png", file.display()));
+    assert_one_error_line(
+        &out,
+        &[&format!(
+            "'{}' exists and is not a directory",
+            file.display()
+        )],
+    );
+    let out = igi(&[
+        "bench",
+        "builtin:cornell-box",
+        "--out",
+        file.to_str().unwrap(),
+    ]);
+    assert_one_error_line(
+        &out,
+        &[&format!(
+            "--out '{}' exists and is not a directory",
+            file.display()
+        )],
+    );
+    // /proc takes no new files: not "No such file or directory" of a directory that is
+    // there (the file is never created).
+    let out = render("/proc/igi-test-takes-no-files.png");
+    if skipped_for_no_adapter(&out) {
+        return;
+    }
+    assert_one_error_line(&out, &["directory '/proc' takes no new files"]);
+}

@@ -23,10 +23,25 @@ use std::sync::OnceLock;
 pub fn write_all(results: &BenchResults, dir: &Path) -> Result<Vec<String>> {
     std::fs::create_dir_all(dir)
         .with_context(|| format!("cannot create directory '{}'", dir.display()))?;
-    write_json(results, &dir.join("results.json"))?;
-    write_csv(results, &dir.join("results.csv"))?;
-    write_markdown(results, &dir.join("results.md"))?;
+    let [json, csv, md] = REPORT_FILES;
+    write_json(results, &dir.join(json))?;
+    write_csv(results, &dir.join(csv))?;
+    write_markdown(results, &dir.join(md))?;
     write_charts(results, dir)
+}
+
+/// The report's files in the output folder, besides the charts ([`chart_files`]).
+pub const REPORT_FILES: [&str; 3] = ["results.json", "results.csv", "results.md"];
+
+/// The chart files of a scene: stages SVG and PNG, error SVG and PNG.
+pub fn chart_files(scene: &str) -> [String; 4] {
+    let stem = file_stem(scene);
+    [
+        format!("stages-{stem}.svg"),
+        format!("stages-{stem}.png"),
+        format!("error-{stem}.svg"),
+        format!("error-{stem}.png"),
+    ]
 }
 
 /// `results.json`: the results as pretty-printed JSON.
@@ -47,8 +62,8 @@ pub fn write_markdown(results: &BenchResults, path: &Path) -> Result<()> {
 }
 
 fn write_file(path: &Path, bytes: &[u8]) -> Result<()> {
-    write_atomically(path, |tmp| {
-        std::fs::write(tmp, bytes).map_err(|e| e.to_string())
+    write_atomically(path, |file| {
+        std::io::Write::write_all(file, bytes).map_err(|e| e.to_string())
     })?;
     Ok(())
 }
@@ -559,16 +574,16 @@ pub fn write_charts(results: &BenchResults, dir: &Path) -> Result<Vec<String>> {
     };
     for scene in scenes(results) {
         let sc = SceneRuns::new(results, &scene);
-        let stem = file_stem(&scene);
+        let [stages_svg, stages_png, error_svg, error_png] = chart_files(&scene);
 
         let size = stages_chart_size(&sc);
         let svg = render_svg(size, |a| draw_stages(a, &sc))
             .map_err(|e| anyhow::anyhow!("stage chart of '{scene}': {e}"))?;
-        write_file(&dir.join(format!("stages-{stem}.svg")), svg.as_bytes())?;
+        write_file(&dir.join(stages_svg), svg.as_bytes())?;
         if png {
             let bytes = render_png(size, |a| draw_stages(a, &sc))
                 .map_err(|e| anyhow::anyhow!("stage chart of '{scene}': {e}"))?;
-            write_file(&dir.join(format!("stages-{stem}.png")), &bytes)?;
+            write_file(&dir.join(stages_png), &bytes)?;
         }
 
         if !sc.has_errors() {
@@ -580,11 +595,11 @@ pub fn write_charts(results: &BenchResults, dir: &Path) -> Result<Vec<String>> {
         let size = (1200, 520);
         let svg = render_svg(size, |a| draw_errors(a, &sc))
             .map_err(|e| anyhow::anyhow!("error chart of '{scene}': {e}"))?;
-        write_file(&dir.join(format!("error-{stem}.svg")), svg.as_bytes())?;
+        write_file(&dir.join(error_svg), svg.as_bytes())?;
         if png {
             let bytes = render_png(size, |a| draw_errors(a, &sc))
                 .map_err(|e| anyhow::anyhow!("error chart of '{scene}': {e}"))?;
-            write_file(&dir.join(format!("error-{stem}.png")), &bytes)?;
+            write_file(&dir.join(error_png), &bytes)?;
         }
     }
     Ok(warnings)

@@ -143,6 +143,56 @@ pub fn utc_now() -> String {
     )
 }
 
+/// The EXR and PNG file names of one combination's image.
+fn image_names(scene: &str, setup: &str, vpls: u32) -> (String, String) {
+    let stem = format!(
+        "{}-{}-{vpls}",
+        super::report::file_stem(scene),
+        setup.replace('+', "_")
+    );
+    (format!("{stem}.exr"), format!("{stem}.png"))
+}
+
+/// Errors where `opts.out` could not be made, or where a file the run writes into it
+/// (images, report, charts) is taken by something that is not a regular file.
+fn check_out(opts: &BenchOptions, setups: &[(String, Accelerations)]) -> Result<()> {
+    let out = &opts.out;
+    if !out.exists() {
+        // create_dir_all fails later where the nearest existing ancestor is a file.
+        if let Some(a) = out.ancestors().skip(1).find(|a| a.exists()) {
+            if !a.is_dir() {
+                bail!(
+                    "--out '{}': cannot create it: '{}' is not a directory",
+                    out.display(),
+                    a.display()
+                );
+            }
+        }
+        return Ok(());
+    }
+    if !out.is_dir() {
+        bail!("--out '{}' exists and is not a directory", out.display());
+    }
+    let mut names: Vec<String> = super::report::REPORT_FILES
+        .iter()
+        .map(|n| n.to_string())
+        .collect();
+    for arg in &opts.scenes {
+        let name = scene_name(arg);
+        names.extend(super::report::chart_files(&name));
+        for (setup, _) in setups {
+            for &vpls in &opts.vpls {
+                let (exr, png) = image_names(&name, setup, vpls);
+                names.extend([exr, png]);
+            }
+        }
+    }
+    for name in names {
+        igi_core::image::output_target(&out.join(name))?;
+    }
+    Ok(())
+}
+
 /// Run the whole benchmark and write its images into `opts.out` (the report is written
 /// by the caller with `report::write_all`).
 pub fn run(opts: &BenchOptions) -> Result<BenchResults> {
@@ -164,11 +214,28 @@ pub fn run(opts: &BenchOptions) -> Result<BenchResults> {
         .map(|s| {
             Accelerations::from_setup(s)
                 .map(|a| (s.clone(), a))
-                .map_err(anyhow::Error::msg)
+                .map_err(|e| anyhow::anyhow!("--setups: {e}"))
         })
         .collect::<Result<_>>()?;
-    std::fs::create_dir_all(&opts.out)
-        .with_context(|| format!("cannot create '{}'", opts.out.display()))?;
+    // Every input is read and every output checked before anything is rendered or
+    // created: a bad scene or reference leaves no empty --out folder, and a report name
+    // taken by a directory no images without their report. The folder itself is made
+    // right before the first image is written.
+    let mut inputs = vec![];
+    for arg in &opts.scenes {
+        let scene = load(arg)?;
+        let reference_path = match &opts.reference {
+            Some(p) => Some(p.clone()),
+            None if !arg.starts_with("builtin:") => find_reference(Path::new(arg)),
+            None => None,
+        };
+        let reference = match &reference_path {
+            Some(p) => Some(Image::read_exr(p)?),
+            None => None,
+        };
+        inputs.push((arg, scene, reference_path, reference));
+    }
+    check_out(opts, &setups)?;
     let ctx = GpuContext::new(&AdapterChoice::from_option(opts.adapter.as_deref()))?;
     if !ctx.timestamps {
         bail!(
@@ -187,23 +254,12 @@ pub fn run(opts: &BenchOptions) -> Result<BenchResults> {
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     let mut runs = vec![];
-    for arg in &opts.scenes {
+    for (arg, scene, reference_path, reference) in inputs {
         let name = scene_name(arg);
-        bar.set_message(format!("{name}: loading"));
-        let scene = load(arg)?;
         let t = Instant::now();
         let bvh = Bvh::build_with(&scene.triangles, opts.bvh);
         let bvh_build_ms = t.elapsed().as_secs_f64() * 1e3;
         let mut renderer = Renderer::new(&ctx, &scene, &bvh)?;
-        let reference_path = match &opts.reference {
-            Some(p) => Some(p.clone()),
-            None if !arg.starts_with("builtin:") => find_reference(Path::new(arg)),
-            None => None,
-        };
-        let reference = match &reference_path {
-            Some(p) => Some(Image::read_exr(p)?),
-            None => None,
-        };
         for (setup, accelerations) in &setups {
             for &vpls in &opts.vpls {
                 bar.set_message(format!("{name} {setup} {vpls} VPLs"));
@@ -264,12 +320,9 @@ pub fn run(opts: &BenchOptions) -> Result<BenchResults> {
                     vpl_shadow: counts[3],
                     particle: counts[4],
                 };
-                let stem = format!(
-                    "{}-{}-{vpls}",
-                    super::report::file_stem(&name),
-                    setup.replace('+', "_")
-                );
-                let (exr, png) = (format!("{stem}.exr"), format!("{stem}.png"));
+                let (exr, png) = image_names(&name, setup, vpls);
+                std::fs::create_dir_all(&opts.out)
+                    .with_context(|| format!("cannot create '{}'", opts.out.display()))?;
                 output.image.write_exr(&opts.out.join(&exr))?;
                 output.image.write_png(&opts.out.join(&png), 1.0)?;
                 let error = match (&reference, &reference_path) {

@@ -63,7 +63,13 @@ pub fn run(opts: ViewOptions) -> Result<()> {
         crate::bvh_built(&bvh, opts.bvh, t.elapsed().as_secs_f64() * 1e3)
     );
     let event_loop = EventLoop::new().map_err(|e| {
-        anyhow!("cannot open a window: {e} (no display: set DISPLAY or WAYLAND_DISPLAY, or run under xvfb-run)")
+        let var = |name: &str| std::env::var(name).ok().filter(|v| !v.is_empty());
+        let wayland = var("WAYLAND_DISPLAY").or_else(|| var("WAYLAND_SOCKET"));
+        anyhow!(no_display_message(
+            &winit_reason(&e),
+            wayland,
+            var("DISPLAY")
+        ))
     })?;
     let mut app = App {
         opts,
@@ -77,6 +83,32 @@ pub fn run(opts: ViewOptions) -> Result<()> {
     match app.error {
         Some(e) => Err(e),
         None => Ok(()),
+    }
+}
+
+/// A winit error without the place in winit's source that raised it: its OS errors read
+/// "os error at /root/.cargo/registry/.../mod.rs:765: REASON", which tells a user nothing.
+fn winit_reason(e: &impl std::fmt::Display) -> String {
+    let text = e.to_string();
+    let reason = match text.strip_prefix("os error at ") {
+        Some(rest) => rest.split_once(": ").map_or(rest, |(_, reason)| reason),
+        None => &text,
+    };
+    reason.trim().trim_end_matches('.').to_string()
+}
+
+/// Why no event loop could start, from winit's `reason` and the display variables as winit
+/// reads them (Wayland first, then X): a display named but not reachable is said by name,
+/// as "set DISPLAY" would be no help there.
+fn no_display_message(reason: &str, wayland: Option<String>, x: Option<String>) -> String {
+    match (wayland, x) {
+        (Some(w), _) => format!(
+            "cannot open a window: cannot connect to Wayland display '{w}' ({reason})"
+        ),
+        (None, Some(d)) => format!(
+            "cannot open a window: cannot connect to display '{d}' ({reason}): start an X server there, or run under xvfb-run"
+        ),
+        (None, None) => "cannot open a window: no display: set DISPLAY or WAYLAND_DISPLAY, or run under xvfb-run".to_string(),
     }
 }
 
@@ -186,7 +218,7 @@ impl Viewer {
         let window = Arc::new(
             event_loop
                 .create_window(attributes)
-                .map_err(|e| anyhow!("cannot open a window: {e}"))?,
+                .map_err(|e| anyhow!("cannot open a window: {}", winit_reason(&e)))?,
         );
         let (ctx, surface) = GpuContext::for_window(
             &opts.adapter,
@@ -650,6 +682,23 @@ fn next_free(stem: &str, ext: &str) -> PathBuf {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn window_errors_name_the_display_not_winits_source() {
+        let e = "os error at /root/.cargo/registry/src/x/winit-0.30.13/src/platform_impl/linux/mod.rs:788: Failed to open connection to X server";
+        assert_eq!(winit_reason(&e), "Failed to open connection to X server");
+        assert_eq!(winit_reason(&"not supported"), "not supported");
+        let x = no_display_message("Failed", None, Some(":99".into()));
+        assert!(
+            x.contains("cannot connect to display ':99' (Failed)"),
+            "{x}"
+        );
+        assert!(!x.contains("set DISPLAY"), "{x}");
+        let w = no_display_message("No compositor", Some("wayland-9".into()), Some(":0".into()));
+        assert!(w.contains("Wayland display 'wayland-9'"), "{w}");
+        let none = no_display_message("neither is set", None, None);
+        assert!(none.contains("set DISPLAY or WAYLAND_DISPLAY"), "{none}");
+    }
 
     #[test]
     fn letterbox_keeps_the_aspect_and_centres() {
