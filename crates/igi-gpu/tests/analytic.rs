@@ -16,20 +16,14 @@ fn point_light_over_diffuse_plane() {
     let rho = Vec3::new(0.5, 0.6, 0.7);
     let intensity = Vec3::new(2.0, 3.0, 4.0);
     let light = Vec3::new(0.5, 1.0, 0.3);
-    let camera = Camera {
-        eye: Vec3::new(0.2, 2.0, 1.5),
-        target: Vec3::new(0.0, 0.0, 0.0),
-        up: Vec3::Y,
-        fov_y_deg: 60.0,
-    };
-    let scene = scene(
-        camera,
-        floor_square(10.0, 0),
-        vec![material("plane", rho, Vec3::ZERO)],
-        vec![PointLight {
+    let camera = floor_camera();
+    let scene = lit_floor(
+        10.0,
+        material("plane", rho, Vec3::ZERO),
+        PointLight {
             position: light,
             intensity,
-        }],
+        },
     );
     let settings = RenderSettings {
         width: 48,

@@ -15,22 +15,15 @@ use igi_gpu::passes::display::{DisplayOptions, DisplayPass};
 use igi_gpu::{GpuContext, Renderer};
 
 fn plane_scene() -> (Scene, Camera) {
-    let camera = Camera {
-        eye: Vec3::new(0.2, 2.0, 1.5),
-        target: Vec3::ZERO,
-        up: Vec3::Y,
-        fov_y_deg: 60.0,
-    };
-    let scene = scene(
-        camera,
-        floor_square(10.0, 0),
-        vec![material("plane", Vec3::splat(0.5), Vec3::ZERO)],
-        vec![PointLight {
+    let scene = lit_floor(
+        10.0,
+        material("plane", Vec3::splat(0.5), Vec3::ZERO),
+        PointLight {
             position: Vec3::new(0.0, 1.0, 0.0),
             intensity: Vec3::ONE,
-        }],
+        },
     );
-    (scene, camera)
+    (scene, floor_camera())
 }
 
 /// A plane seen from above: every normal is +y (shown as 0.5 + 0.5 n) and the depth

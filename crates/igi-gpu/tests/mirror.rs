@@ -8,7 +8,7 @@ mod common;
 use common::*;
 use glam::Vec3;
 use igi_core::bvh::{offset_ray_origin, Bvh};
-use igi_core::scene::{Camera, PointLight, Scene};
+use igi_core::scene::{PointLight, Scene};
 use igi_core::settings::{InterleavePattern, OutputBuffer, RenderSettings};
 use igi_core::vpl::{reflect, surface_at};
 use igi_gpu::passes::indirect::list_pixels_per_group;
@@ -370,20 +370,13 @@ fn gather_ranges_cover_the_frames_vpls_not_every_slot() {
     let Some(ctx) = gpu() else {
         return;
     };
-    let camera = Camera {
-        eye: Vec3::new(0.2, 2.0, 1.5),
-        target: Vec3::ZERO,
-        up: Vec3::Y,
-        fov_y_deg: 60.0,
-    };
-    let scene = scene(
-        camera,
-        floor_square(1.0, 0),
-        vec![material("half mirror", Vec3::splat(0.3), Vec3::splat(0.5))],
-        vec![PointLight {
+    let scene = lit_floor(
+        1.0,
+        material("half mirror", Vec3::splat(0.3), Vec3::splat(0.5)),
+        PointLight {
             position: Vec3::new(0.0, 1.0, 0.0),
             intensity: Vec3::ONE,
-        }],
+        },
     );
     let settings = RenderSettings {
         width: 8,

@@ -106,6 +106,27 @@ pub fn scene(
     }
 }
 
+/// The camera of [`lit_floor`]: above the floor, looking down at its centre.
+pub fn floor_camera() -> Camera {
+    Camera {
+        eye: Vec3::new(0.2, 2.0, 1.5),
+        target: Vec3::ZERO,
+        up: Vec3::Y,
+        fov_y_deg: 60.0,
+    }
+}
+
+/// The square floor of [`floor_square`] (half side `half`) of one material, open to the
+/// sky, under one point light, seen by [`floor_camera`].
+pub fn lit_floor(half: f32, material: Material, light: PointLight) -> Scene {
+    scene(
+        floor_camera(),
+        floor_square(half, 0),
+        vec![material],
+        vec![light],
+    )
+}
+
 /// A sphere of radius `r` about the origin from a subdivided icosahedron, with radial
 /// shading normals.
 pub fn icosphere(r: f32, subdivisions: u32, material: u32) -> Vec<Triangle> {
