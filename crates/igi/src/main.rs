@@ -1004,13 +1004,7 @@ fn main() -> ExitCode {
 fn error_line(e: &anyhow::Error) -> String {
     let causes: Vec<String> = e
         .chain()
-        .map(|cause| {
-            let text = cause.to_string();
-            match text.rfind(" (os error ") {
-                Some(i) if text.ends_with(')') => text[..i].to_string(),
-                _ => text,
-            }
-        })
+        .map(|cause| igi_core::scene::without_os_error_code(&cause.to_string()).to_string())
         .collect();
     causes
         .join(": ")

@@ -198,12 +198,16 @@ fn context_suffix(context: &Option<String>) -> String {
 
 /// The OS message without its " (os error 2)" tail: "No such file or directory".
 fn io_message(e: &io::Error) -> String {
-    let s = e.to_string();
-    let s = match s.rfind(" (os error ") {
-        Some(i) if s.ends_with(')') => &s[..i],
-        _ => &s[..],
-    };
-    one_line(s)
+    one_line(without_os_error_code(&e.to_string()))
+}
+
+/// `text` without the " (os error 2)" tail that Rust adds to an OS error's message (the
+/// message says it in words); the `igi` command drops it from every error it prints.
+pub fn without_os_error_code(text: &str) -> &str {
+    match text.rfind(" (os error ") {
+        Some(i) if text.ends_with(')') => &text[..i],
+        _ => text,
+    }
 }
 
 /// Messages quote file contents and paths: keep them on one line.
