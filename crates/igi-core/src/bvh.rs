@@ -87,7 +87,11 @@ pub const SAH_INTERSECT_COST: f32 = 1.0;
 /// [`Bvh::tri_rows`]. An empty child (the second child of a root that is a single leaf,
 /// both children of the BVH of no triangles) has min = max = +inf, count 1, index 0:
 /// [`BvhChild::EMPTY`], a box no ray with a finite tmax hits.
-#[repr(C)]
+///
+/// Aligned to 16 bytes (the WGSL layout does not change: its size is 64) so that the build
+/// can lay the nodes out in the allocation of its 16-byte-aligned references, whose pages
+/// are mapped already (see `build`).
+#[repr(C, align(16))]
 #[derive(Clone, Copy, Pod, Zeroable, Debug, PartialEq)]
 pub struct BvhNode {
     pub a_min: [f32; 3],
@@ -223,15 +227,23 @@ pub struct BuildStats {
     /// sum over interior nodes of C_t A(n)/A(root) + sum over leaves of C_i N A(l)/A(root).
     pub sah_cost: f32,
     /// Wall time of the build's phases in milliseconds, in order: the references (and
-    /// their split clipping), the node arrays' allocation, the tree, the rows, the
-    /// layout.
+    /// their split clipping), the node arrays' allocation, the tree, the layout, the
+    /// rows.
     pub phases: Vec<(&'static str, f64)>,
 }
 
+/// One row of [`Bvh::tri_rows`]: one coordinate (x, y or z) of a slot's vertices 0, 1
+/// and 2, and 0. Aligned to 16 bytes like [`BvhNode`], of which it is a quarter, so that
+/// the build can write the rows into the allocation of its node places, whose pages are
+/// mapped already (see `build`).
+#[repr(C, align(16))]
+#[derive(Clone, Copy, Pod, Zeroable, Debug, PartialEq)]
+pub struct TriRow(pub [f32; 4]);
+
 /// Vertices 0, 1 and 2 of BVH slot `slot` of [`Bvh::tri_rows`].
 #[inline]
-fn rows_to_vertices(tri_rows: &[[f32; 4]], slot: usize) -> [Vec3; 3] {
-    let [x, y, z] = &tri_rows[3 * slot..3 * slot + 3] else {
+fn rows_to_vertices(tri_rows: &[TriRow], slot: usize) -> [Vec3; 3] {
+    let [TriRow(x), TriRow(y), TriRow(z)] = &tri_rows[3 * slot..3 * slot + 3] else {
         unreachable!("a slot has three rows")
     };
     [0, 1, 2].map(|j| Vec3::new(x[j], y[j], z[j]))
@@ -246,7 +258,7 @@ pub struct Bvh {
     /// coordinates of its vertices 0, 1 and 2 (w = 0). The triangle test reads the rows of
     /// the ray's Woop axes (kx, ky, kz) by index; stored as vertices, the coordinates had
     /// to be permuted with 18 selects a test (docs/PERFORMANCE.md attempt 102).
-    pub tri_rows: Vec<[f32; 4]>,
+    pub tri_rows: Vec<TriRow>,
     /// BVH slot -> index of the triangle in the slice given to the build. Each triangle
     /// has one slot, or more with [`BvhBuilder::Split`] (one per piece).
     pub tri_order: Vec<u32>,

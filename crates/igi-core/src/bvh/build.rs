@@ -33,8 +33,8 @@ use std::time::Instant;
 use glam::{Vec3, Vec3A};
 
 use super::{
-    BuildStats, Bvh, BvhChild, BvhNode, MAX_DEPTH, MAX_LEAF_SIZE, SAH_BINS, SAH_INTERSECT_COST,
-    SAH_TRAVERSAL_COST,
+    BuildStats, Bvh, BvhChild, BvhNode, TriRow, MAX_DEPTH, MAX_LEAF_SIZE, SAH_BINS,
+    SAH_INTERSECT_COST, SAH_TRAVERSAL_COST,
 };
 use crate::scene::Triangle;
 
@@ -350,13 +350,63 @@ where
     (va, vb, results)
 }
 
-/// [`par_vec2`] for one vector.
-fn par_vec<T, I>(n: usize, item: I) -> Vec<T>
+/// An empty vector of `B` in the allocation of `v`, whose items are dropped, where that
+/// holds `n` of them (the same alignment, and a size that divides); otherwise a new one.
+/// A buffer that a finished phase wrote has its pages mapped, a new one does not (see
+/// `build_impl`).
+pub(super) fn reuse_vec<A: bytemuck::NoUninit, B: bytemuck::AnyBitPattern>(
+    mut v: Vec<A>,
+    n: usize,
+) -> Vec<B> {
+    v.clear();
+    match bytemuck::allocation::try_cast_vec::<A, B>(v) {
+        Ok(b) if b.capacity() >= n => b,
+        _ => Vec::with_capacity(n),
+    }
+}
+
+/// The allocation of the node places as an empty vector of rows: a [`BvhNode`] is four
+/// [`TriRow`]s in size and alignment.
+pub(super) fn places_as_rows(places: Box<Places<BvhNode>>) -> Vec<TriRow> {
+    const _: () = assert!(
+        std::mem::size_of::<BvhNode>() == 4 * std::mem::size_of::<TriRow>()
+            && std::mem::align_of::<BvhNode>() == std::mem::align_of::<TriRow>()
+    );
+    let len = places.len();
+    let ptr = Box::into_raw(places).cast::<TriRow>();
+    // SAFETY: the allocation holds `len` BvhNodes, which is the layout (size and alignment,
+    // asserted above) of 4 len TriRows; a vector of length 0 reads none of it, and the
+    // places' contents need no drop (MaybeUninit).
+    unsafe { Vec::from_raw_parts(ptr, 0, 4 * len) }
+}
+
+/// Writes the three rows of each slot (see [`Bvh::tri_rows`]) of the triangles `ids`
+/// into `rows` (empty; grown where it is too small), on all threads.
+fn triangle_rows<F>(mut rows: Vec<TriRow>, tri: &F, ids: &mut [u32]) -> Vec<TriRow>
 where
-    T: Send + Sync,
-    I: Fn(usize) -> T + Sync,
+    F: Fn(usize) -> [Vec3; 3] + Sync,
 {
-    par_vec2(n, 0, |i| (item(i), ()), |_| ()).0
+    let refs = ids.len();
+    if rows.capacity() < 3 * refs {
+        rows = Vec::with_capacity(3 * refs);
+    }
+    let spare = &mut rows.spare_capacity_mut()[..3 * refs];
+    // SAFETY: [MaybeUninit<TriRow>; 3] has the layout of three MaybeUninit<TriRow> in a
+    // row, so the 3 refs places are refs triples.
+    let slots = unsafe {
+        std::slice::from_raw_parts_mut(spare.as_mut_ptr().cast::<MaybeUninit<[TriRow; 3]>>(), refs)
+    };
+    par_chunks_zip(slots, ids, |_, slots, ids| {
+        for (slot, &id) in slots.iter_mut().zip(ids.iter()) {
+            let [v0, v1, v2] = tri(id as usize);
+            slot.write([0, 1, 2].map(|axis| TriRow([v0[axis], v1[axis], v2[axis], 0.0])));
+        }
+    });
+    // SAFETY: par_chunks_zip ran the closure over every slot, which wrote its three rows.
+    unsafe { rows.set_len(3 * refs) };
+    // Gives back the places' pages beyond the rows (in place: no copy).
+    rows.shrink_to_fit();
+    rows
 }
 
 /// The chunk length of [`par_chunks`] for `n` items, or None where one thread does it all.
@@ -414,7 +464,9 @@ where
     // Early split clipping appends pieces: room for as many again as there are
     // triangles, which costs nothing until written, so that the references are not
     // copied to a larger vector (more pieces than that still fit, after one copy).
-    let spare = if limits.split { count } else { 0 };
+    // An even capacity in all, so that the layout can have the allocation (two
+    // references to a node, see reuse_vec).
+    let spare = if limits.split { count } else { count % 2 };
     let (mut prims, bounds, mut cbounds, tri_area) = whole_references(count, &tri, spare);
     let mut ids: Vec<u32> = Vec::with_capacity(count + spare);
     ids.extend(0..count as u32);
@@ -464,7 +516,7 @@ where
         &limits,
         &tri_area,
     );
-    drop((prims, slot_area, tri_area));
+    drop((slot_area, tri_area));
     if root.count > 0 {
         // A root that is a leaf still needs an interior node 0 to hold its box; the leaf
         // is its child, at depth 1, and stays child a.
@@ -479,21 +531,24 @@ where
     }
     phases.lap("tree");
 
+    // Rotations and larger_first moved subtrees around: each node's subtrees right after it
+    // again, with child a the likelier occluder (occluder_first). Laid out where the
+    // references were (they are done with), and the rows written where the node places
+    // were: in a new process (what `igi render` pays) the build's first touch of fresh
+    // memory costs a page fault per 4 KiB, about 1.7 us on the 2-core machine, and these
+    // two buffers had been 26 MB of the 52 MB it touched on the conference room
+    // (docs/PERFORMANCE.md attempt 113).
+    let (nodes_out, interior_area, deepest) =
+        depth_first_layout(&nodes, &info, reuse_vec(prims, interior_count(&info)));
+    drop(info);
+    phases.lap("layout");
+
     // Per slot the x, y and z rows of its vertices (see Bvh::tri_rows). In a pass of its
     // own rather than at the leaves: the reads of scattered triangles overlap here, and
     // the leaves took twice as long over them (docs/PERFORMANCE.md attempt 111).
-    let rows = par_vec(refs, |slot| {
-        let [v0, v1, v2] = tri(ids[slot] as usize);
-        [0, 1, 2].map(|axis| [v0[axis], v1[axis], v2[axis], 0.0])
-    });
-    let tri_rows: Vec<[f32; 4]> = bytemuck::allocation::cast_vec(rows);
+    let tri_rows = triangle_rows(places_as_rows(nodes), &tri, &mut ids);
     phases.lap("rows");
-
-    // Rotations and larger_first moved subtrees around: each node's subtrees right after it
-    // again, with child a the likelier occluder (occluder_first).
-    let (nodes, interior_area, deepest) = depth_first_layout(&nodes, &info);
-    drop(info);
-    phases.lap("layout");
+    let nodes = nodes_out;
     let mut build_stats = stats(
         count,
         refs,
@@ -613,7 +668,7 @@ struct NodeInfo {
 /// once [`Region::set`] has stored it: `build_node` hands out a node's reference after
 /// setting it, and the rotations only store nodes that were set before. So no unwritten
 /// place is read ([`written`]).
-type Places<T> = [MaybeUninit<T>];
+pub(super) type Places<T> = [MaybeUninit<T>];
 
 /// The node (or [`NodeInfo`]) at place `i`.
 ///
@@ -880,11 +935,12 @@ const LAYOUT_SPLIT_LEVELS: u32 = 2;
 fn depth_first_layout(
     nodes: &Places<BvhNode>,
     info: &Places<NodeInfo>,
+    mut out: Vec<BvhNode>,
 ) -> (Vec<BvhNode>, f64, u32) {
-    // SAFETY: the root's place is written (see Places).
-    let interior = unsafe { written(info, 0) }.interior as usize;
+    let interior = interior_count(info);
     // Written once by the walks, not zeroed first (1 ms of the 2-core machine).
-    let mut out: Vec<BvhNode> = Vec::with_capacity(interior);
+    out.clear();
+    out.reserve(interior);
     let (area, deepest) = lay_out(
         nodes,
         info,
@@ -897,7 +953,15 @@ fn depth_first_layout(
     // of interior count m (the root's is `interior`) from its own place on, over m
     // places, which it checks node by node (m = 1 + its children's counts).
     unsafe { out.set_len(interior) };
+    // Gives back the pages beyond the nodes (in place: no copy).
+    out.shrink_to_fit();
     (out, area, deepest)
+}
+
+/// Interior nodes of the tree (the root's subtree).
+fn interior_count(info: &Places<NodeInfo>) -> usize {
+    // SAFETY: the root's place is written (see Places).
+    unsafe { written(info, 0) }.interior as usize
 }
 
 /// Lays out the subtree of node `root` (at `depth`) into `out`, whose first place has the

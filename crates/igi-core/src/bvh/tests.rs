@@ -64,14 +64,14 @@ fn check_structure_of(bvh: &Bvh, tris: &[[Vec3; 3]], builder: BvhBuilder) {
     let phases: Vec<&str> = bvh.build_stats.phases.iter().map(|p| p.0).collect();
     let expected: &[&str] = match (n, builder) {
         (0, _) => &[],
-        (_, BvhBuilder::Binned) => &["references", "node arrays", "tree", "rows", "layout"],
+        (_, BvhBuilder::Binned) => &["references", "node arrays", "tree", "layout", "rows"],
         (_, BvhBuilder::Split) => &[
             "references",
             "split clipping",
             "node arrays",
             "tree",
-            "rows",
             "layout",
+            "rows",
         ],
     };
     assert_eq!(phases, expected);
@@ -239,7 +239,8 @@ fn check_ray(bvh: &Bvh, tris: &[[Vec3; 3]], o: Vec3, d: Vec3, tmax: f32) -> usiz
 #[test]
 fn node_layout_matches_wgsl() {
     assert_eq!(std::mem::size_of::<BvhNode>(), 64);
-    assert_eq!(std::mem::align_of::<BvhNode>(), 4);
+    // 16, as the build's references, whose allocation it reuses; the GPU does not care.
+    assert_eq!(std::mem::align_of::<BvhNode>(), 16);
     let offsets = [
         std::mem::offset_of!(BvhNode, a_min),
         std::mem::offset_of!(BvhNode, a_index),
@@ -1251,4 +1252,30 @@ fn slab_minima_on_bits_agree_with_floats() {
         cases.len()
     );
     assert!(hits > cases.len() / 4, "too few hits ({hits})");
+}
+
+/// The layout goes where the references were and the rows where the node places were
+/// (their pages are mapped already); where an allocation does not fit, a new one.
+#[test]
+fn finished_buffers_are_reused_where_they_fit() {
+    use super::build::{places_as_rows, reuse_vec, PrimRef};
+    let prims: Vec<PrimRef> = Vec::with_capacity(10);
+    let at = prims.as_ptr() as usize;
+    let nodes: Vec<BvhNode> = reuse_vec(prims, 5);
+    assert_eq!((nodes.as_ptr() as usize, nodes.capacity()), (at, 5));
+    // Too small (a new one has exactly the capacity asked for), or an odd number of
+    // references (half a node), which cannot be cast: new allocations.
+    let nodes: Vec<BvhNode> = reuse_vec(nodes, 6);
+    assert_eq!((nodes.len(), nodes.capacity()), (0, 6));
+    let odd: Vec<PrimRef> = Vec::with_capacity(9);
+    let nodes: Vec<BvhNode> = reuse_vec(odd, 3);
+    assert_eq!((nodes.len(), nodes.capacity()), (0, 3));
+
+    let places: Box<[std::mem::MaybeUninit<BvhNode>]> = Box::new_uninit_slice(3);
+    let at = places.as_ptr() as usize;
+    let rows = places_as_rows(places);
+    assert_eq!(
+        (rows.as_ptr() as usize, rows.capacity(), rows.len()),
+        (at, 12, 0)
+    );
 }

@@ -345,7 +345,7 @@ fn intersect_triangle(r: &TraceRay, [xr, yr, zr]: [Vec3; 3], tmax: f32) -> Optio
 #[inline]
 fn slot_rows(bvh: &Bvh, slot: u32, r: &TraceRay) -> [Vec3; 3] {
     let i = 3 * slot as usize;
-    [r.kx, r.ky, r.kz].map(|k| Vec3::from_slice(&bvh.tri_rows[i + k][..3]))
+    [r.kx, r.ky, r.kz].map(|k| Vec3::from_slice(&bvh.tri_rows[i + k].0[..3]))
 }
 
 /// The rows of a triangle given by its vertices, in the ray's Woop axes.
