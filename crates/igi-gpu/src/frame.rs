@@ -1315,7 +1315,8 @@ pub fn filter_chain(a: &Accelerations) -> (Option<Filter>, bool) {
 fn check_accelerations(settings: &RenderSettings) -> Result<(), GpuError> {
     let a = &settings.accelerations;
     let (n, m) = a.interleave;
-    if n == 0 || m == 0 || n * m > MAX_SUBSETS {
+    // In 64 bits: n x m of two large u32 sides wraps around in 32.
+    if n == 0 || m == 0 || u64::from(n) * u64::from(m) > u64::from(MAX_SUBSETS) {
         return Err(GpuError::Limit(format!(
             "interleave {n}x{m}: each side must be at least 1 and n x m at most {MAX_SUBSETS}"
         )));
@@ -1336,3 +1337,24 @@ fn check_accelerations(settings: &RenderSettings) -> Result<(), GpuError> {
 
 /// Most VPL subsets of interleaved sampling (the irregular pattern's permutation array).
 pub const MAX_SUBSETS: u32 = 64;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn interleave_sides_whose_product_wraps_in_32_bits_are_refused() {
+        let mut settings = RenderSettings::default();
+        settings.accelerations.interleave = (3, 3);
+        assert!(check_accelerations(&settings).is_ok());
+        // 65536 x 65536 is 0 in u32.
+        for interleave in [(65_536, 65_536), (8, 9), (0, 4), (u32::MAX, 2)] {
+            settings.accelerations.interleave = interleave;
+            let err = check_accelerations(&settings).expect_err("refused");
+            assert!(
+                err.to_string().contains("at most 64"),
+                "{interleave:?}: {err}"
+            );
+        }
+    }
+}
