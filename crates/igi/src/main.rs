@@ -830,6 +830,17 @@ fn bench_rays(args: &RaysArgs) -> Result<()> {
         bail!("--schedule refill applies to shadow rays (any hit): give --kind shadow or both");
     }
     let scene = igi::bench::run::load(&args.scene)?;
+    if let Some(path) = &args.save {
+        // Before the rays are made, which can take long: a name that cannot be written,
+        // or that is one of the scene's files, is an error now.
+        let save = igi::outputs::Output {
+            option: "--save",
+            path,
+            format: igi::outputs::Format::Rays,
+            other: "",
+        };
+        igi::outputs::check(&[save], &scene.files)?;
+    }
     let t = Instant::now();
     let builder = args.bvh.builder.into();
     let bvh = Bvh::build_with(&scene.triangles, builder);

@@ -10,6 +10,8 @@ use std::path::{Path, PathBuf};
 pub enum Format {
     Png,
     Exr,
+    /// A ray file (`bench rays --save`): any name.
+    Rays,
 }
 
 /// One output file and the option that named it.
@@ -37,9 +39,10 @@ pub fn check(outputs: &[Output], inputs: &[PathBuf]) -> Result<()> {
         let (named, writes) = match out.format {
             Format::Png => ("exr", "an sRGB PNG"),
             Format::Exr => ("png", "OpenEXR"),
+            Format::Rays => ("", ""),
         };
         let ext = out.path.extension().map(|e| e.to_string_lossy());
-        if ext.is_some_and(|e| e.eq_ignore_ascii_case(named)) {
+        if !named.is_empty() && ext.is_some_and(|e| e.eq_ignore_ascii_case(named)) {
             bail!(
                 "{} {}: {} writes {writes}, not .{named} ({})",
                 out.option,

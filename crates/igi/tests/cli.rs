@@ -250,6 +250,41 @@ fn bench_runs_tiny_and_its_json_parses() {
     assert!(d.join(&run.image_exr).exists());
 }
 
+/// `--save` is checked before the rays are made (a frame set of 2^28 rays takes
+/// minutes on a software adapter): a missing directory or the scene's own file is an
+/// error at once, whatever adapter there is.
+#[test]
+fn bench_rays_checks_its_save_file_first() {
+    let d = temp_dir("rays-save");
+    let scene = scene_with_obj(&d, QUAD);
+    let scene_text = std::fs::read_to_string(&scene).unwrap();
+    let missing = d.join("no/such/dir/rays.bin");
+    for (save, words) in [
+        (
+            missing.to_str().unwrap(),
+            vec!["no/such/dir", "does not exist"],
+        ),
+        (
+            scene.to_str().unwrap(),
+            vec!["--save", "the scene was read from"],
+        ),
+    ] {
+        let out = igi(&[
+            "bench",
+            "rays",
+            scene.to_str().unwrap(),
+            "--kind",
+            "shadow",
+            "--adapter",
+            "no-such-adapter",
+            "--save",
+            save,
+        ]);
+        assert_one_error_line(&out, &words);
+    }
+    assert_eq!(std::fs::read_to_string(&scene).unwrap(), scene_text);
+}
+
 #[test]
 fn bench_rays_saves_and_loads_the_same_rays() {
     let d = temp_dir("rays");
