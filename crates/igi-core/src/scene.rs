@@ -11,7 +11,10 @@ pub mod loader;
 use glam::Vec3;
 use std::path::PathBuf;
 
-pub use loader::{camera_toml, load_scene, parse_camera_toml, without_os_error_code, SceneError};
+pub use loader::{
+    camera_toml, load_scene, max_light_intensity, parse_camera_toml, without_os_error_code,
+    SceneError,
+};
 
 /// A pinhole camera, as `[camera]` in the scene file.
 #[derive(Clone, Copy, Debug, PartialEq)]

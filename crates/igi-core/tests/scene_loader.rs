@@ -1194,6 +1194,30 @@ fn light_of_zero_power_loads_and_unrepresentable_power_is_refused() {
     expect_err(r, "scene.toml", &["4 lights' total power", "32-bit floats"]);
 }
 
+/// The bound an editor (the viewer's light panel) puts on a light's channel is the one
+/// loading checks: a scene with that value loads, and one 1% above it is refused.
+#[test]
+fn max_light_intensity_is_what_loading_accepts() {
+    let bright = "[[point_light]]\nposition = [0.0, 0.0, 3.0]\nintensity = [1e37, 2e36, 0.0]\n";
+    let (dir, toml) = valid_scene("light-max");
+    let text = format!("{toml}\n{bright}");
+    let scene = dir.load(&text).expect("valid");
+    let (index, channel) = (1, 2);
+    let max = igi_core::scene::max_light_intensity(&scene.lights, index, channel);
+    assert!(max > 1e36, "room left: {max:e}");
+    let with = |x: f32| {
+        let light = format!("intensity = [1e37, 2e36, {x:e}]");
+        text.replace("intensity = [1e37, 2e36, 0.0]", &light)
+    };
+    let at_max = dir.load(&with(max)).expect("the bound itself loads");
+    assert_eq!(at_max.lights[index].intensity[channel], max);
+    let r = dir.load(&with(max * 1.01));
+    expect_err(r, "scene.toml", &["power", "32-bit floats"]);
+    // A light whose others use up the range has none left.
+    let lights = [scene.lights.clone(), vec![scene.lights[1]; 3]].concat();
+    assert_eq!(igi_core::scene::max_light_intensity(&lights, 0, 0), 0.0);
+}
+
 #[test]
 fn large_valid_triangles_are_kept_and_degenerate_ones_dropped() {
     // Edges of 2e10 (and 2e30): the f32 cross product overflows, the triangle is fine.

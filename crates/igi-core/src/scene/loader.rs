@@ -837,6 +837,27 @@ fn light_power_f64(intensity: Vec3) -> f64 {
     4.0 * std::f64::consts::PI * intensity.as_dvec3().element_sum()
 }
 
+/// The largest value that channel `channel` (0, 1, 2: r, g, b) of light `index` may take,
+/// the other channels and lights as they are, for the lights' total power to stay within
+/// f32 as loading requires ([`check_total_power`]); for editors such as the viewer's
+/// light panel, where a drag could otherwise push the sum past it at run time.
+pub fn max_light_intensity(lights: &[PointLight], index: usize, channel: usize) -> f32 {
+    let others: f64 = lights
+        .iter()
+        .enumerate()
+        .map(|(i, l)| {
+            let mut v = l.intensity.as_dvec3();
+            if i == index {
+                v[channel] = 0.0;
+            }
+            v.element_sum()
+        })
+        .sum();
+    let room = f32::MAX as f64 / (4.0 * std::f64::consts::PI) - others;
+    // A margin far above the rounding of the f32 sums (and of this cast).
+    (room.max(0.0) * (1.0 - 1e-6)) as f32
+}
+
 /// Refuses lights whose summed power overflows f32: light choice on the GPU and CPU
 /// divides by that sum, and an infinite one made every VPL's flux NaN (a NaN image). A
 /// light that emits nothing is fine (it is never chosen); each TOML light was checked on

@@ -3,7 +3,7 @@
 //! [`ViewState`]; the viewer compares it with the last frame's to restart accumulation.
 
 use egui::{ComboBox, DragValue, Slider, Ui};
-use igi_core::scene::PointLight;
+use igi_core::scene::{max_light_intensity, PointLight};
 use igi_core::settings::{
     FilterMode, GeometryBound, InterleavePattern, OutputBuffer, RenderSettings,
 };
@@ -269,6 +269,9 @@ fn lights(ui: &mut Ui, state: &mut ViewState, diagonal: f32) {
                 ui.selectable_value(&mut state.selected_light, i, format!("light {i}"));
             }
         });
+    // Each channel at most what keeps the lights' total power within f32, as loading
+    // requires (beyond it, light choice divides by infinity and the image turns NaN).
+    let max = [0, 1, 2].map(|c| max_light_intensity(&state.lights, state.selected_light, c));
     let light = &mut state.lights[state.selected_light];
     let speed = 0.002 * diagonal;
     ui.horizontal(|ui| {
@@ -280,12 +283,8 @@ fn lights(ui: &mut Ui, state: &mut ViewState, diagonal: f32) {
     let step = 0.01 * light.intensity.max_element().max(0.1);
     ui.horizontal(|ui| {
         ui.label("intensity");
-        for c in 0..3 {
-            ui.add(
-                DragValue::new(&mut light.intensity[c])
-                    .speed(step)
-                    .range(0.0..=f32::MAX),
-            );
+        for (channel, max) in light.intensity.as_mut().iter_mut().zip(max) {
+            ui.add(DragValue::new(channel).speed(step).range(0.0..=max));
         }
     });
 }
