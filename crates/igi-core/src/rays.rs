@@ -131,8 +131,23 @@ pub const MAX_RAYS: usize = 1 << 28;
 
 /// Whether a ray set of `count` rays can be made here: at most [`MAX_RAYS`], and the host
 /// memory for generating it (the surface points and the rays) can be had now. The reason
-/// otherwise, so that a huge count is one clear error instead of an aborted allocation.
+/// otherwise, so that a huge count is one clear error instead of an aborted allocation
+/// (or, where the system overcommits memory and any reservation succeeds, the OOM
+/// killer): on Linux the need is compared with MemAvailable of /proc/meminfo.
 pub fn check_ray_count(count: usize) -> Result<(), String> {
+    check_ray_count_within(count, available_memory())
+}
+
+/// The memory the system can give without swapping (MemAvailable, Linux), in bytes.
+fn available_memory() -> Option<u64> {
+    let meminfo = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = meminfo.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    kib.checked_mul(1024)
+}
+
+/// [`check_ray_count`] with the available memory given (None: unknown).
+fn check_ray_count_within(count: usize, available: Option<u64>) -> Result<(), String> {
     if count > MAX_RAYS {
         return Err(format!(
             "at most {MAX_RAYS} rays ({} GiB of rays at 32 bytes a ray)",
@@ -141,6 +156,13 @@ pub fn check_ray_count(count: usize) -> Result<(), String> {
     }
     // Two sets of surface points (position and normal, 24 bytes each) and the rays.
     let bytes = count * (2 * 24 + 32);
+    if let Some(available) = available.filter(|&a| bytes as u64 > a) {
+        return Err(format!(
+            "the {} MiB that {count} rays need are more than the {} MiB of memory available here",
+            bytes >> 20,
+            available >> 20
+        ));
+    }
     let mut probe: Vec<u8> = Vec::new();
     probe.try_reserve_exact(bytes).map_err(|_| {
         format!(
@@ -262,7 +284,14 @@ mod tests {
     #[test]
     fn huge_counts_are_refused_before_allocating() {
         assert!(check_ray_count(1 << 20).is_ok());
-        assert!(check_ray_count(MAX_RAYS).is_ok() || cfg!(target_pointer_width = "32"));
+        assert!(
+            check_ray_count_within(MAX_RAYS, None).is_ok() || cfg!(target_pointer_width = "32")
+        );
+        // More than the memory available (1 GiB here): refused, though the probe's
+        // reservation might succeed where the system overcommits.
+        let e = check_ray_count_within(1 << 24, Some(1 << 30)).unwrap_err();
+        assert!(e.contains("1280 MiB") && e.contains("1024 MiB"), "{e}");
+        assert!(check_ray_count_within(1 << 23, Some(1 << 30)).is_ok());
         let e = check_ray_count(u32::MAX as usize).unwrap_err();
         assert!(e.contains(&format!("at most {MAX_RAYS} rays")), "{e}");
         assert!(check_ray_count(usize::MAX).is_err());
