@@ -75,10 +75,15 @@ fn main() {
     let mut phases: Vec<(&str, Vec<f64>)> = vec![];
     let mut bvh = None;
     let cpu_start = process_cpu_seconds();
+    let mut first_faults = None;
     for _ in 0..runs {
+        let faults = minor_faults();
         let t = Instant::now();
         let b = Bvh::build_with(&triangles, builder);
         times.push(t.elapsed().as_secs_f64() * 1e3);
+        if first_faults.is_none() {
+            first_faults = minor_faults().zip(faults).map(|(b, a)| b - a);
+        }
         for (k, &(name, ms)) in b.build_stats.phases.iter().enumerate() {
             if k == phases.len() {
                 phases.push((name, vec![]));
@@ -111,6 +116,11 @@ fn main() {
         })
         .collect();
     out!("phases, median ms: {}", medians.join(", "));
+    if let Some(faults) = first_faults {
+        // What the first build in a new process pays for fresh memory (about 1.7 us a
+        // page on the 2-core machine; docs/PERFORMANCE.md attempt 113).
+        out!("minor page faults of the first build: {faults}");
+    }
     // Equal hashes: the same tree, for checking that a change to the builder keeps it.
     let mut hash = 0xcbf2_9ce4_8422_2325u64;
     for byte in bytemuck::cast_slice::<_, u8>(&bvh.nodes)
@@ -207,6 +217,14 @@ fn load_obj(path: &std::path::Path) -> Vec<Triangle> {
 
 /// User + system time of this process so far (all threads, finished ones included), from
 /// /proc/self/stat (Linux; clock ticks of 10 ms: meaningful over several builds).
+/// Minor page faults of the process so far (Linux: /proc/self/stat); None elsewhere.
+fn minor_faults() -> Option<u64> {
+    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // minflt is the 8th field after the command name (which ends with ')').
+    let rest = &stat[stat.rfind(')')? + 2..];
+    rest.split_whitespace().nth(7)?.parse().ok()
+}
+
 fn process_cpu_seconds() -> Option<f64> {
     let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
     // Fields after the command name (which ends with ')'): utime and stime are the 12th

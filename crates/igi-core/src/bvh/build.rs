@@ -381,7 +381,8 @@ pub(super) fn places_as_rows(places: Box<Places<BvhNode>>) -> Vec<TriRow> {
 }
 
 /// Writes the three rows of each slot (see [`Bvh::tri_rows`]) of the triangles `ids`
-/// into `rows` (empty; grown where it is too small), on all threads.
+/// into `rows` (empty; grown where it is too small), on all threads (`ids` is only read;
+/// it is split alike by `par_chunks_zip`, which takes two mutable slices).
 fn triangle_rows<F>(mut rows: Vec<TriRow>, tri: &F, ids: &mut [u32]) -> Vec<TriRow>
 where
     F: Fn(usize) -> [Vec3; 3] + Sync,
@@ -404,7 +405,7 @@ where
     });
     // SAFETY: par_chunks_zip ran the closure over every slot, which wrote its three rows.
     unsafe { rows.set_len(3 * refs) };
-    // Gives back the places' pages beyond the rows (in place: no copy).
+    // Gives back the places' pages beyond the rows (glibc shrinks in place, no copy).
     rows.shrink_to_fit();
     rows
 }
@@ -953,7 +954,7 @@ fn depth_first_layout(
     // of interior count m (the root's is `interior`) from its own place on, over m
     // places, which it checks node by node (m = 1 + its children's counts).
     unsafe { out.set_len(interior) };
-    // Gives back the pages beyond the nodes (in place: no copy).
+    // Gives back the pages beyond the nodes (glibc shrinks in place, no copy).
     out.shrink_to_fit();
     (out, area, deepest)
 }
