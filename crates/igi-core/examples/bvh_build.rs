@@ -217,20 +217,27 @@ fn load_obj(path: &std::path::Path) -> Vec<Triangle> {
 
 /// User + system time of this process so far (all threads, finished ones included), from
 /// /proc/self/stat (Linux; clock ticks of 10 ms: meaningful over several builds).
-/// Minor page faults of the process so far (Linux: /proc/self/stat); None elsewhere.
-fn minor_faults() -> Option<u64> {
+/// Fields of /proc/self/stat after the command name (which ends with ')'), numbered
+/// from 0 (the state); None where there is no such file (not Linux).
+fn proc_stat_fields() -> Option<Vec<u64>> {
     let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
-    // minflt is the 8th field after the command name (which ends with ')').
     let rest = &stat[stat.rfind(')')? + 2..];
-    rest.split_whitespace().nth(7)?.parse().ok()
+    // The state is a letter; the fields wanted here are numbers.
+    Some(
+        rest.split_whitespace()
+            .map(|f| f.parse().unwrap_or(0))
+            .collect(),
+    )
 }
 
+/// Minor page faults of the process so far (minflt, field 7).
+fn minor_faults() -> Option<u64> {
+    proc_stat_fields()?.get(7).copied()
+}
+
+/// CPU time of the process so far, all threads (utime and stime, fields 11 and 12, in
+/// ticks of 1/100 s).
 fn process_cpu_seconds() -> Option<f64> {
-    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
-    // Fields after the command name (which ends with ')'): utime and stime are the 12th
-    // and 13th of them.
-    let rest = &stat[stat.rfind(')')? + 2..];
-    let fields: Vec<&str> = rest.split_whitespace().collect();
-    let ticks: f64 = fields.get(11)?.parse::<f64>().ok()? + fields.get(12)?.parse::<f64>().ok()?;
-    Some(ticks / 100.0)
+    let fields = proc_stat_fields()?;
+    Some((fields.get(11)? + fields.get(12)?) as f64 / 100.0)
 }

@@ -539,8 +539,7 @@ where
     // memory costs a page fault per 4 KiB, about 1.7 us on the 2-core machine, and these
     // two buffers had been 26 MB of the 52 MB it touched on the conference room
     // (docs/PERFORMANCE.md attempt 113).
-    let (nodes_out, interior_area, deepest) =
-        depth_first_layout(&nodes, &info, reuse_vec(prims, interior_count(&info)));
+    let (nodes_out, interior_area, deepest) = depth_first_layout(&nodes, &info, prims);
     drop(info);
     phases.lap("layout");
 
@@ -936,12 +935,13 @@ const LAYOUT_SPLIT_LEVELS: u32 = 2;
 fn depth_first_layout(
     nodes: &Places<BvhNode>,
     info: &Places<NodeInfo>,
-    mut out: Vec<BvhNode>,
+    references: Vec<PrimRef>,
 ) -> (Vec<BvhNode>, f64, u32) {
-    let interior = interior_count(info);
-    // Written once by the walks, not zeroed first (1 ms of the 2-core machine).
-    out.clear();
-    out.reserve(interior);
+    // SAFETY: the root's place is written (see Places).
+    let interior = unsafe { written(info, 0) }.interior as usize;
+    // In the finished references' allocation (see build_impl); written once by the walks,
+    // not zeroed first (1 ms of the 2-core machine).
+    let mut out: Vec<BvhNode> = reuse_vec(references, interior);
     let (area, deepest) = lay_out(
         nodes,
         info,
@@ -957,12 +957,6 @@ fn depth_first_layout(
     // Gives back the pages beyond the nodes (glibc shrinks in place, no copy).
     out.shrink_to_fit();
     (out, area, deepest)
-}
-
-/// Interior nodes of the tree (the root's subtree).
-fn interior_count(info: &Places<NodeInfo>) -> usize {
-    // SAFETY: the root's place is written (see Places).
-    unsafe { written(info, 0) }.interior as usize
 }
 
 /// Lays out the subtree of node `root` (at `depth`) into `out`, whose first place has the
