@@ -36,13 +36,16 @@ pub fn check(outputs: &[Output], inputs: &[PathBuf]) -> Result<()> {
         .collect();
     let mut targets: Vec<(PathBuf, &Output)> = vec![];
     for out in outputs {
-        let (named, writes) = match out.format {
-            Format::Png => ("exr", "an sRGB PNG"),
-            Format::Exr => ("png", "OpenEXR"),
-            Format::Rays => ("", ""),
+        // The extension of the other image format, and what this option writes.
+        let other_format = match out.format {
+            Format::Png => Some(("exr", "an sRGB PNG")),
+            Format::Exr => Some(("png", "OpenEXR")),
+            Format::Rays => None,
         };
         let ext = out.path.extension().map(|e| e.to_string_lossy());
-        if !named.is_empty() && ext.is_some_and(|e| e.eq_ignore_ascii_case(named)) {
+        if let Some((named, writes)) =
+            other_format.filter(|(named, _)| ext.is_some_and(|e| e.eq_ignore_ascii_case(named)))
+        {
             bail!(
                 "{} {}: {} writes {writes}, not .{named} ({})",
                 out.option,

@@ -251,8 +251,8 @@ fn bench_runs_tiny_and_its_json_parses() {
 }
 
 /// `--save` is checked before the rays are made (a frame set of 2^28 rays takes
-/// minutes on a software adapter): a missing directory or the scene's own file is an
-/// error at once, whatever adapter there is.
+/// minutes on a software adapter): a missing directory, a directory or the scene's own
+/// file is one error at once, whatever adapter there is.
 #[test]
 fn bench_rays_checks_its_save_file_first() {
     let d = temp_dir("rays-save");
@@ -263,6 +263,10 @@ fn bench_rays_checks_its_save_file_first() {
         (
             missing.to_str().unwrap(),
             vec!["no/such/dir", "does not exist"],
+        ),
+        (
+            d.to_str().unwrap(),
+            vec!["cannot write", "a directory, not a regular file"],
         ),
         (
             scene.to_str().unwrap(),
@@ -1196,29 +1200,6 @@ fn bench_makes_its_folder_only_after_its_inputs_and_outputs_are_checked() {
     );
     assert_one_error_line(&out, &["results.md", "not a regular file"]);
     assert_eq!(names_in(&out_dir), ["results.md"]);
-}
-
-#[test]
-fn a_ray_file_that_cannot_be_saved_is_said_once() {
-    let d = temp_dir("rays-save-dir");
-    let out = igi_in_time(
-        &[
-            "bench",
-            "rays",
-            "builtin:cornell-box",
-            "--runs",
-            "1",
-            "--count",
-            "64",
-            "--kind",
-            "shadow",
-            "--save",
-            d.to_str().unwrap(),
-        ],
-        120,
-    );
-    // Said before any adapter is asked for (bench_rays_checks_its_save_file_first).
-    assert_one_error_line(&out, &["cannot write", "a directory, not a regular file"]);
 }
 
 #[test]

@@ -846,15 +846,16 @@ pub fn max_light_intensity(lights: &[PointLight], index: usize, channel: usize) 
         .iter()
         .enumerate()
         .map(|(i, l)| {
-            let mut v = l.intensity.as_dvec3();
+            let mut intensity = l.intensity;
             if i == index {
-                v[channel] = 0.0;
+                intensity[channel] = 0.0;
             }
-            v.element_sum()
+            light_power_f64(intensity)
         })
         .sum();
-    let room = f32::MAX as f64 / (4.0 * std::f64::consts::PI) - others;
-    // A margin far above the rounding of the f32 sums (and of this cast).
+    // The power left, as this channel's intensity (power = 4 pi intensity), with a
+    // margin far above the rounding of the f32 sums and of this cast.
+    let room = (f32::MAX as f64 - others) / light_power_f64(Vec3::X);
     (room.max(0.0) * (1.0 - 1e-6)) as f32
 }
 
