@@ -975,9 +975,35 @@ fn quiet_on_closed_pipes() {
     }
 }
 
+/// Mesa's Vulkan drivers (lavapipe among them) connect to a Wayland display when an
+/// instance is made, for window surfaces; where `XDG_RUNTIME_DIR` is not set
+/// (containers, CI runners, many ssh sessions), libwayland then prints "error:
+/// XDG_RUNTIME_DIR is invalid or not set in the environment." once per instance, lines
+/// that read like igi failing and that break the one error line of a real failure. For
+/// the commands that open no window, a `WAYLAND_DISPLAY` that is an absolute path to no
+/// socket makes that connection fail without a word (libwayland needs no runtime
+/// directory for an absolute path). Where a Wayland session is set up, nothing changes.
+#[cfg(unix)]
+fn no_wayland_for_headless_commands() {
+    let set = |name: &str| std::env::var_os(name).is_some_and(|v| !v.is_empty());
+    let runtime_dir =
+        std::env::var_os("XDG_RUNTIME_DIR").is_some_and(|d| std::path::Path::new(&d).is_absolute());
+    if !runtime_dir && !set("WAYLAND_DISPLAY") && !set("WAYLAND_SOCKET") {
+        // Called in main before any other thread exists (see main), so no thread can
+        // read the environment while it changes.
+        std::env::set_var("WAYLAND_DISPLAY", "/nonexistent/igi-opens-no-window");
+    }
+}
+
 fn main() -> ExitCode {
     #[cfg(unix)]
     quiet_on_closed_pipes();
+    let cli = Cli::parse();
+    #[cfg(unix)]
+    if !matches!(cli.command, Command::View(_)) {
+        no_wayland_for_headless_commands();
+    }
+    // The first thread besides main: the environment is settled by now.
     #[cfg(unix)]
     if let Err(e) = igi::outputs::remove_partial_files_on_signals() {
         eprintln!("error: cannot handle signals: {}", error_line(&e));
@@ -989,7 +1015,6 @@ fn main() -> ExitCode {
     )
     .format_timestamp(None)
     .init();
-    let cli = Cli::parse();
     let result = match &cli.command {
         Command::Render(args) => render(args),
         Command::View(args) => view(args),

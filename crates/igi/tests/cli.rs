@@ -185,6 +185,35 @@ fn no_adapter_says_what_to_install() {
     assert_one_error_line(&out, &["mesa-vulkan-drivers"]);
 }
 
+#[test]
+fn no_runtime_dir_prints_no_error_lines() {
+    // Containers and CI runners often have no XDG_RUNTIME_DIR; Mesa's Vulkan drivers then
+    // made libwayland print "error: XDG_RUNTIME_DIR is invalid ..." twice on a render
+    // that succeeded. A render that works prints no line that starts with "error".
+    let d = temp_dir("no-runtime-dir");
+    let png = d.join("cb.png");
+    let out = Command::new(env!("CARGO_BIN_EXE_igi"))
+        .args(["render", "--builtin", "cornell-box"])
+        .args(["--width", "16", "--height", "16", "-o"])
+        .arg(&png)
+        .env_remove("XDG_RUNTIME_DIR")
+        .env_remove("WAYLAND_DISPLAY")
+        .env_remove("WAYLAND_SOCKET")
+        .output()
+        .unwrap();
+    if skipped_for_no_adapter(&out) {
+        return;
+    }
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    let errors: Vec<&str> = stderr.lines().filter(|l| l.starts_with("error")).collect();
+    assert!(
+        errors.is_empty(),
+        "error lines from a render that worked: {errors:?}"
+    );
+    assert!(png.exists());
+}
+
 fn skipped_for_no_adapter(out: &Output) -> bool {
     let stderr = String::from_utf8_lossy(&out.stderr);
     if stderr.contains("no GPU adapter") {
