@@ -8,7 +8,7 @@ pub mod builtin;
 pub mod gltf;
 pub mod loader;
 
-use glam::Vec3;
+use glam::{Vec3, Vec3A};
 use std::path::PathBuf;
 
 pub use loader::{
@@ -115,7 +115,7 @@ fn pow2(j: i32) -> f32 {
 /// unscaled ones do, without their overflow (edges past ~1e19) or underflow. Twin of
 /// frame.wgsl's `scale_pow2`; the factor is applied in two halves so that each stays a
 /// normal f32.
-pub fn scale_pow2(e: Vec3) -> Vec3 {
+pub fn scale_pow2(e: Vec3A) -> Vec3A {
     let m = e.abs().max_element();
     let k = 126 - ((m.to_bits() >> 23) & 0xff) as i32;
     e * pow2(k / 2) * pow2(k - k / 2)
@@ -128,15 +128,23 @@ pub fn scale_pow2(e: Vec3) -> Vec3 {
 /// product overflows) is kept and gets the normal the GPU computes, and every other
 /// triangle gets exactly the normal of the plain formula. The loaders keep what this
 /// accepts.
+///
+/// In `Vec3A`, whose fourth lane glam keeps a copy of z, and not `Vec3`: LLVM vectorised
+/// the `Vec3` arithmetic with fourth lanes left undefined, whose products were often
+/// subnormal, and each cost a microcode assist: 100-115 ns a triangle on the 2-core
+/// machine against 13 with subnormals flushed, 30 ms of loading the conference room.
+/// The results are the same bit for bit (the same products and sums in the same order;
+/// the tests compare with the plain formula).
 pub fn geometric_normal(v: &[Vec3; 3]) -> Option<Vec3> {
-    let (e1, e2) = (v[1] - v[0], v[2] - v[0]);
+    let [a, b, c] = v.map(Vec3A::from);
+    let (e1, e2) = (b - a, c - a);
     if !(e1.is_finite() && e2.is_finite()) {
         return None;
     }
-    let c = scale_pow2(e1).cross(scale_pow2(e2));
+    let n = scale_pow2(e1).cross(scale_pow2(e2));
     // At most 2 per component: the length is finite.
-    let len = c.length();
-    (len > 0.0).then(|| c / len)
+    let len = n.length();
+    (len > 0.0).then(|| Vec3::from(n / len))
 }
 
 /// Length of the box diagonal hi - lo, in f64: its f32 square overflows once the box
