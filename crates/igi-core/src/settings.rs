@@ -176,7 +176,8 @@ pub struct RenderSettings {
     /// Bounding distance m of the geometry term; `None` = [`default_min_dist`].
     pub min_dist: Option<f32>,
     pub geometry_bound: GeometryBound,
-    /// Depth limit of the Whitted mirror tree (reflections after the primary hit).
+    /// Depth limit of the Whitted mirror tree (reflections after the primary hit); at
+    /// most [`MAX_MIRROR_DEPTH`].
     pub mirror_depth: u32,
     pub seed: u32,
     /// Frame number within an accumulation sequence: picks a fresh window of the Halton
@@ -188,6 +189,13 @@ pub struct RenderSettings {
     /// Frames averaged into the image, each with a fresh VPL set (1 = one frame).
     pub accumulate: u32,
 }
+
+/// Most mirror reflections a walk follows ([`RenderSettings::mirror_depth`]). The passes
+/// count a walk's reflections, and a light path's segments (bounces + mirror depth), in
+/// u32: without a bound `--mirror-depth 4294967295` wrapped the path length of the VPL
+/// pass to 7 segments. It also bounds the work of a pixel that sees a hall of mirrors
+/// (one closest-hit ray per reflection); the viewer's slider stops at 16.
+pub const MAX_MIRROR_DEPTH: u32 = 1024;
 
 impl Default for RenderSettings {
     fn default() -> Self {

@@ -101,7 +101,7 @@ pub fn shoot_vpls(
         let mut dir = uniform_sphere(halton(1, index), halton(2, index));
         let mut stored = 0;
         let mut dim = 3;
-        for _ in 0..bounces + mirror_depth {
+        for _ in 0..bounces.saturating_add(mirror_depth) {
             let Some(hit) = bvh.trace_closest(origin, dir, f32::INFINITY) else {
                 break;
             };

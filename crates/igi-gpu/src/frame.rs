@@ -25,6 +25,7 @@ use igi_core::sampling::{halton_base, pilot_base, DigitPermutations};
 use igi_core::scene::{Camera, PointLight, Scene};
 use igi_core::settings::{
     Accelerations, FilterMode, GeometryBound, InterleavePattern, OutputBuffer, RenderSettings,
+    MAX_MIRROR_DEPTH,
 };
 
 /// Most stages a frame can have (VPL shooting + direct, VPL list, mirror chains, mirror
@@ -741,7 +742,7 @@ impl Renderer {
         accumulate_index: u32,
     ) -> Result<(Vec<&'static str>, u32), GpuError> {
         Self::check_size(ctx, settings)?;
-        check_accelerations(settings)?;
+        check_settings(settings)?;
         let paths = self.path_count(ctx, settings)?;
         self.ensure_permutations(ctx, settings.seed);
         let bounces = settings.bounces.max(1);
@@ -1311,8 +1312,15 @@ pub fn filter_chain(a: &Accelerations) -> (Option<Filter>, bool) {
     }
 }
 
-/// Reject acceleration parameters the passes cannot honour.
-fn check_accelerations(settings: &RenderSettings) -> Result<(), GpuError> {
+/// Reject settings the passes cannot honour: acceleration parameters, and a mirror depth
+/// past [`MAX_MIRROR_DEPTH`].
+fn check_settings(settings: &RenderSettings) -> Result<(), GpuError> {
+    if settings.mirror_depth > MAX_MIRROR_DEPTH {
+        return Err(GpuError::Limit(format!(
+            "mirror depth {}: at most {MAX_MIRROR_DEPTH} reflections",
+            settings.mirror_depth
+        )));
+    }
     let a = &settings.accelerations;
     let (n, m) = a.interleave;
     // In 64 bits: n x m of two large u32 sides wraps around in 32.
@@ -1346,15 +1354,30 @@ mod tests {
     fn interleave_sides_whose_product_wraps_in_32_bits_are_refused() {
         let mut settings = RenderSettings::default();
         settings.accelerations.interleave = (3, 3);
-        assert!(check_accelerations(&settings).is_ok());
+        assert!(check_settings(&settings).is_ok());
         // 65536 x 65536 is 0 in u32.
         for interleave in [(65_536, 65_536), (8, 9), (0, 4), (u32::MAX, 2)] {
             settings.accelerations.interleave = interleave;
-            let err = check_accelerations(&settings).expect_err("refused");
+            let err = check_settings(&settings).expect_err("refused");
             assert!(
                 err.to_string().contains("at most 64"),
                 "{interleave:?}: {err}"
             );
+        }
+    }
+
+    #[test]
+    fn mirror_depths_past_the_bound_are_refused() {
+        let mut settings = RenderSettings {
+            mirror_depth: MAX_MIRROR_DEPTH,
+            ..RenderSettings::default()
+        };
+        assert!(check_settings(&settings).is_ok());
+        // u32::MAX wrapped the VPL pass's path length (bounces + mirror depth) to 7.
+        for depth in [MAX_MIRROR_DEPTH + 1, u32::MAX] {
+            settings.mirror_depth = depth;
+            let err = check_settings(&settings).expect_err("refused");
+            assert!(err.to_string().contains("at most 1024"), "{depth}: {err}");
         }
     }
 }

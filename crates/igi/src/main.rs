@@ -8,6 +8,7 @@ use igi_core::bvh::{Bvh, BvhBuilder};
 use igi_core::scene::{builtin, load_scene, Scene};
 use igi_core::settings::{
     Accelerations, FilterMode, GeometryBound, InterleavePattern, OutputBuffer, RenderSettings,
+    MAX_MIRROR_DEPTH,
 };
 use igi_gpu::{AdapterChoice, GpuContext, Renderer};
 use std::path::PathBuf;
@@ -266,7 +267,7 @@ struct FrameArgs {
     /// How G is bounded near VPLs.
     #[arg(long, value_enum, default_value = "smoothstep")]
     bound: BoundArg,
-    /// Depth limit of mirror reflections.
+    /// Depth limit of mirror reflections (at most 1024).
     #[arg(long, default_value_t = 6)]
     mirror_depth: u32,
     /// Seed of the VPL set (a window of the Halton sequence).
@@ -644,6 +645,12 @@ fn settings(scene: &Scene, f: &FrameArgs) -> Result<RenderSettings> {
     }
     if f.accel.accumulate == 0 {
         bail!("--accumulate must be at least 1");
+    }
+    if f.mirror_depth > MAX_MIRROR_DEPTH {
+        bail!(
+            "--mirror-depth must be at most {MAX_MIRROR_DEPTH}, got {}",
+            f.mirror_depth
+        );
     }
     if let Some(m) = f.min_dist {
         if !(m.is_finite() && m > 0.0) {

@@ -94,6 +94,25 @@ fn output_in_missing_directory() {
 }
 
 #[test]
+fn mirror_depth_past_the_bound_is_one_error() {
+    // u32::MAX, "no limit" to a user, wrapped the VPL pass's path length to 7 segments.
+    let d = temp_dir("mirror-depth");
+    let png = d.join("x.png");
+    for depth in ["1025", "4294967295"] {
+        let out = igi(&[
+            "render",
+            "--builtin",
+            "cornell-box",
+            "--mirror-depth",
+            depth,
+            "-o",
+            png.to_str().unwrap(),
+        ]);
+        assert_one_error_line(&out, &["--mirror-depth", "at most 1024", depth]);
+        assert!(!png.exists(), "an output after an error");
+    }
+}
+#[test]
 fn missing_files_other_than_scenes_are_named_in_words() {
     let d = temp_dir("missing-inputs");
     let nowhere = d.join("nowhere.exr");
