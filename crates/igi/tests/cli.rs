@@ -112,6 +112,7 @@ fn mirror_depth_past_the_bound_is_one_error() {
         assert!(!png.exists(), "an output after an error");
     }
 }
+
 #[test]
 fn missing_files_other_than_scenes_are_named_in_words() {
     let d = temp_dir("missing-inputs");
