@@ -262,7 +262,7 @@ struct FrameArgs {
     #[arg(long, default_value_t = 8)]
     bounces: u32,
     /// Bounding distance m of the geometry term (default: 5% of the scene's diagonal).
-    #[arg(long, value_name = "M")]
+    #[arg(long, allow_negative_numbers = true, value_name = "M")]
     min_dist: Option<f32>,
     /// How G is bounded near VPLs.
     #[arg(long, value_enum, default_value = "smoothstep")]
@@ -308,19 +308,19 @@ struct AccelArgs {
     #[arg(long, value_enum)]
     filter: Option<FilterArg>,
     /// Spatial sigma of the upsampler, in low-resolution pixels.
-    #[arg(long, value_name = "PIXELS")]
+    #[arg(long, allow_negative_numbers = true, value_name = "PIXELS")]
     upsample_sigma: Option<f32>,
     /// Exponent k of the upsampler's normal weight (N_p . N_q)^k (the paper: 1).
-    #[arg(long, value_name = "K")]
+    #[arg(long, allow_negative_numbers = true, value_name = "K")]
     normal_power: Option<f32>,
     /// Leave depth out of the upsampler's range weight (the paper's normal-only weight).
     #[arg(long)]
     no_upsample_depth: bool,
     /// Relative depth difference that counts as a discontinuity.
-    #[arg(long, value_name = "FRACTION")]
+    #[arg(long, allow_negative_numbers = true, value_name = "FRACTION")]
     depth_threshold: Option<f32>,
     /// Smallest normal dot product of continuous neighbours.
-    #[arg(long, value_name = "COS")]
+    #[arg(long, allow_negative_numbers = true, value_name = "COS")]
     normal_threshold: Option<f32>,
     /// Average K frames, each with a fresh VPL set (a still camera converges).
     #[arg(long, value_name = "K", default_value_t = 1)]
@@ -460,7 +460,7 @@ struct RenderArgs {
     #[arg(long, value_name = "EXR")]
     exr: Option<PathBuf>,
     /// Multiplier applied before tone mapping the PNG (the EXR stays unscaled).
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 1.0)]
     exposure: f32,
     /// Which buffer to write.
     #[arg(long, value_enum, default_value = "final")]
@@ -479,7 +479,7 @@ struct ViewArgs {
     #[command(flatten)]
     frame: FrameArgs,
     /// Multiplier applied before tone mapping (the panel changes it).
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 1.0)]
     exposure: f32,
     /// Which buffer to show first.
     #[arg(long, value_enum, default_value = "final")]

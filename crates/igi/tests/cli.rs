@@ -114,6 +114,26 @@ fn mirror_depth_past_the_bound_is_one_error() {
 }
 
 #[test]
+fn negative_numbers_reach_the_checks() {
+    // clap took the "-1" after --exposure for a flag ("unexpected argument '-1' found"),
+    // and a valid --normal-threshold of -0.5 could only be given as "=-0.5".
+    let d = temp_dir("negative-numbers");
+    let png = d.join("x.png");
+    let out = igi(&[
+        "render",
+        "--builtin",
+        "cornell-box",
+        "-o",
+        png.to_str().unwrap(),
+        "--normal-threshold",
+        "-0.5",
+        "--exposure",
+        "-1",
+    ]);
+    assert_one_error_line(&out, &["--exposure must be a positive number, got -1"]);
+}
+
+#[test]
 fn missing_files_other_than_scenes_are_named_in_words() {
     let d = temp_dir("missing-inputs");
     let nowhere = d.join("nowhere.exr");
