@@ -97,7 +97,7 @@ struct RaysArgs {
     /// The scene file (TOML), or builtin:NAME.
     scene: String,
     /// Number of rays.
-    #[arg(long, default_value_t = 1 << 24)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 1 << 24)]
     count: usize,
     /// Which query to time.
     #[arg(long, value_enum, default_value = "both")]
@@ -118,20 +118,20 @@ struct RaysArgs {
     )]
     load: Option<PathBuf>,
     /// Timed runs after one warm-up; the median is reported.
-    #[arg(long, default_value_t = 10)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 10)]
     runs: u32,
     /// How the any-hit query hands rays to GPU threads (closest hits: one per thread).
     #[arg(long, value_enum, default_value = "auto")]
     schedule: ScheduleArg,
     /// VPLs of the frame set.
-    #[arg(long, default_value_t = 180)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 180)]
     vpls: u32,
     /// Image size of the frame set (default: the scene's film).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     width: Option<u32>,
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     height: Option<u32>,
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 0)]
     seed: u32,
     #[command(flatten)]
     bvh: BvhChoice,
@@ -146,7 +146,12 @@ struct BenchArgs {
     #[arg(required = true)]
     scenes: Vec<String>,
     /// VPL counts, comma-separated.
-    #[arg(long, value_delimiter = ',', default_value = "30,90,180")]
+    #[arg(
+        long,
+        allow_negative_numbers = true,
+        value_delimiter = ',',
+        default_value = "30,90,180"
+    )]
     vpls: Vec<u32>,
     /// Set-ups, comma-separated: canonical, or iv, ds, il, irregular, fused joined by '+'.
     #[arg(
@@ -156,10 +161,10 @@ struct BenchArgs {
     )]
     setups: Vec<String>,
     /// Timed frames per combination.
-    #[arg(long, default_value_t = 10)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 10)]
     frames: u32,
     /// Untimed frames before them.
-    #[arg(long, default_value_t = 3)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 3)]
     warmup: u32,
     /// Reference image (EXR) for one scene; otherwise one is looked for beside each scene
     /// (../../references/NAME-full.exr, or NAME-reference.exr).
@@ -169,12 +174,12 @@ struct BenchArgs {
     #[arg(long, default_value = "bench-out")]
     out: PathBuf,
     /// Image width (default: each scene's film).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     width: Option<u32>,
     /// Image height (default: each scene's film).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     height: Option<u32>,
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 0)]
     seed: u32,
     #[command(flatten)]
     bvh: BvhChoice,
@@ -250,16 +255,16 @@ struct SceneArgs {
 #[derive(Args)]
 struct FrameArgs {
     /// Image width (default: the scene's film).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     width: Option<u32>,
     /// Image height (default: the scene's film).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     height: Option<u32>,
     /// Number of VPLs (the paper uses 30, 90, 180); the actual count is reported.
-    #[arg(long, default_value_t = 180)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 180)]
     vpls: u32,
     /// Maximum diffuse bounces of a light path (VPLs per path).
-    #[arg(long, default_value_t = 8)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 8)]
     bounces: u32,
     /// Bounding distance m of the geometry term (default: 5% of the scene's diagonal).
     #[arg(long, allow_negative_numbers = true, value_name = "M")]
@@ -268,10 +273,10 @@ struct FrameArgs {
     #[arg(long, value_enum, default_value = "smoothstep")]
     bound: BoundArg,
     /// Depth limit of mirror reflections (at most 1024).
-    #[arg(long, default_value_t = 6)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 6)]
     mirror_depth: u32,
     /// Seed of the VPL set (a window of the Halton sequence).
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 0)]
     seed: u32,
     #[command(flatten)]
     bvh: BvhChoice,
@@ -294,7 +299,7 @@ struct AccelArgs {
     #[arg(long)]
     imperfect_visibility: bool,
     /// Indirect light at 1/S of the resolution per axis, then joint bilateral upsampling.
-    #[arg(long, value_name = "S")]
+    #[arg(long, allow_negative_numbers = true, value_name = "S")]
     downsample: Option<u32>,
     /// Interleaved sampling over NxM VPL subsets (N x M at most 64), then the discontinuity
     /// buffer (e.g. 3x3).
@@ -323,7 +328,12 @@ struct AccelArgs {
     #[arg(long, allow_negative_numbers = true, value_name = "COS")]
     normal_threshold: Option<f32>,
     /// Average K frames, each with a fresh VPL set (a still camera converges).
-    #[arg(long, value_name = "K", default_value_t = 1)]
+    #[arg(
+        long,
+        allow_negative_numbers = true,
+        value_name = "K",
+        default_value_t = 1
+    )]
     accumulate: u32,
 }
 
@@ -489,17 +499,22 @@ struct ViewArgs {
     #[arg(long, value_name = "FILE|TOML")]
     camera: Option<String>,
     /// Render N frames, then exit (with --screenshot: save it first).
-    #[arg(long, value_name = "N")]
+    #[arg(long, allow_negative_numbers = true, value_name = "N")]
     frames: Option<u32>,
     /// Where screenshots go: PNG at the panel's exposure, and the linear frame as EXR
     /// beside it (default: igi-screenshot-N.png in the working directory).
     #[arg(long, value_name = "PNG")]
     screenshot: Option<PathBuf>,
     /// Still frames averaged at most.
-    #[arg(long, default_value_t = 256)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 256)]
     max_accumulate: u32,
     /// Render at 1/S of the window's resolution (faster on slow adapters).
-    #[arg(long, value_name = "S", default_value_t = 1)]
+    #[arg(
+        long,
+        allow_negative_numbers = true,
+        value_name = "S",
+        default_value_t = 1
+    )]
     scale: u32,
     /// Draw the VPLs as dots.
     #[arg(long)]

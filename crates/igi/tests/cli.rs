@@ -131,6 +131,10 @@ fn negative_numbers_reach_the_checks() {
         "-1",
     ]);
     assert_one_error_line(&out, &["--exposure must be a positive number, got -1"]);
+    // An integer option names itself and the value, with no tip about "-- -5".
+    let out = igi(&["render", "--builtin", "cornell-box", "--vpls", "-5"]);
+    assert_one_error_line(&out, &["'-5'", "--vpls"]);
+    assert!(!String::from_utf8_lossy(&out.stderr).contains("-- -5"));
 }
 
 #[test]
