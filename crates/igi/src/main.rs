@@ -3,7 +3,7 @@
 //! interactive viewer; `igi bench` measures; `igi info` lists the GPU adapters.
 
 use anyhow::{bail, Context, Result};
-use clap::{Args, Parser, Subcommand, ValueEnum};
+use clap::{Args, CommandFactory, FromArgMatches, Parser, Subcommand, ValueEnum};
 use igi_core::bvh::{Bvh, BvhBuilder};
 use igi_core::scene::{builtin, load_scene, Scene};
 use igi_core::settings::{
@@ -97,7 +97,7 @@ struct RaysArgs {
     /// The scene file (TOML), or builtin:NAME.
     scene: String,
     /// Number of rays.
-    #[arg(long, allow_negative_numbers = true, default_value_t = 1 << 24)]
+    #[arg(long, default_value_t = 1 << 24)]
     count: usize,
     /// Which query to time.
     #[arg(long, value_enum, default_value = "both")]
@@ -118,20 +118,20 @@ struct RaysArgs {
     )]
     load: Option<PathBuf>,
     /// Timed runs after one warm-up; the median is reported.
-    #[arg(long, allow_negative_numbers = true, default_value_t = 10)]
+    #[arg(long, default_value_t = 10)]
     runs: u32,
     /// How the any-hit query hands rays to GPU threads (closest hits: one per thread).
     #[arg(long, value_enum, default_value = "auto")]
     schedule: ScheduleArg,
     /// VPLs of the frame set.
-    #[arg(long, allow_negative_numbers = true, default_value_t = 180)]
+    #[arg(long, default_value_t = 180)]
     vpls: u32,
     /// Image size of the frame set (default: the scene's film).
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long)]
     width: Option<u32>,
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long)]
     height: Option<u32>,
-    #[arg(long, allow_negative_numbers = true, default_value_t = 0)]
+    #[arg(long, default_value_t = 0)]
     seed: u32,
     #[command(flatten)]
     bvh: BvhChoice,
@@ -146,12 +146,7 @@ struct BenchArgs {
     #[arg(required = true)]
     scenes: Vec<String>,
     /// VPL counts, comma-separated.
-    #[arg(
-        long,
-        allow_negative_numbers = true,
-        value_delimiter = ',',
-        default_value = "30,90,180"
-    )]
+    #[arg(long, value_delimiter = ',', default_value = "30,90,180")]
     vpls: Vec<u32>,
     /// Set-ups, comma-separated: canonical, or iv, ds, il, irregular, fused joined by '+'.
     #[arg(
@@ -161,10 +156,10 @@ struct BenchArgs {
     )]
     setups: Vec<String>,
     /// Timed frames per combination.
-    #[arg(long, allow_negative_numbers = true, default_value_t = 10)]
+    #[arg(long, default_value_t = 10)]
     frames: u32,
     /// Untimed frames before them.
-    #[arg(long, allow_negative_numbers = true, default_value_t = 3)]
+    #[arg(long, default_value_t = 3)]
     warmup: u32,
     /// Reference image (EXR) for one scene; otherwise one is looked for beside each scene
     /// (../../references/NAME-full.exr, or NAME-reference.exr).
@@ -174,12 +169,12 @@ struct BenchArgs {
     #[arg(long, default_value = "bench-out")]
     out: PathBuf,
     /// Image width (default: each scene's film).
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long)]
     width: Option<u32>,
     /// Image height (default: each scene's film).
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long)]
     height: Option<u32>,
-    #[arg(long, allow_negative_numbers = true, default_value_t = 0)]
+    #[arg(long, default_value_t = 0)]
     seed: u32,
     #[command(flatten)]
     bvh: BvhChoice,
@@ -255,28 +250,28 @@ struct SceneArgs {
 #[derive(Args)]
 struct FrameArgs {
     /// Image width (default: the scene's film).
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long)]
     width: Option<u32>,
     /// Image height (default: the scene's film).
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long)]
     height: Option<u32>,
     /// Number of VPLs (the paper uses 30, 90, 180); the actual count is reported.
-    #[arg(long, allow_negative_numbers = true, default_value_t = 180)]
+    #[arg(long, default_value_t = 180)]
     vpls: u32,
     /// Maximum diffuse bounces of a light path (VPLs per path).
-    #[arg(long, allow_negative_numbers = true, default_value_t = 8)]
+    #[arg(long, default_value_t = 8)]
     bounces: u32,
     /// Bounding distance m of the geometry term (default: 5% of the scene's diagonal).
-    #[arg(long, allow_negative_numbers = true, value_name = "M")]
+    #[arg(long, value_name = "M")]
     min_dist: Option<f32>,
     /// How G is bounded near VPLs.
     #[arg(long, value_enum, default_value = "smoothstep")]
     bound: BoundArg,
     /// Depth limit of mirror reflections (at most 1024).
-    #[arg(long, allow_negative_numbers = true, default_value_t = 6)]
+    #[arg(long, default_value_t = 6)]
     mirror_depth: u32,
     /// Seed of the VPL set (a window of the Halton sequence).
-    #[arg(long, allow_negative_numbers = true, default_value_t = 0)]
+    #[arg(long, default_value_t = 0)]
     seed: u32,
     #[command(flatten)]
     bvh: BvhChoice,
@@ -299,7 +294,7 @@ struct AccelArgs {
     #[arg(long)]
     imperfect_visibility: bool,
     /// Indirect light at 1/S of the resolution per axis, then joint bilateral upsampling.
-    #[arg(long, allow_negative_numbers = true, value_name = "S")]
+    #[arg(long, value_name = "S")]
     downsample: Option<u32>,
     /// Interleaved sampling over NxM VPL subsets (N x M at most 64), then the discontinuity
     /// buffer (e.g. 3x3).
@@ -313,27 +308,22 @@ struct AccelArgs {
     #[arg(long, value_enum)]
     filter: Option<FilterArg>,
     /// Spatial sigma of the upsampler, in low-resolution pixels.
-    #[arg(long, allow_negative_numbers = true, value_name = "PIXELS")]
+    #[arg(long, value_name = "PIXELS")]
     upsample_sigma: Option<f32>,
     /// Exponent k of the upsampler's normal weight (N_p . N_q)^k (the paper: 1).
-    #[arg(long, allow_negative_numbers = true, value_name = "K")]
+    #[arg(long, value_name = "K")]
     normal_power: Option<f32>,
     /// Leave depth out of the upsampler's range weight (the paper's normal-only weight).
     #[arg(long)]
     no_upsample_depth: bool,
     /// Relative depth difference that counts as a discontinuity.
-    #[arg(long, allow_negative_numbers = true, value_name = "FRACTION")]
+    #[arg(long, value_name = "FRACTION")]
     depth_threshold: Option<f32>,
     /// Smallest normal dot product of continuous neighbours.
-    #[arg(long, allow_negative_numbers = true, value_name = "COS")]
+    #[arg(long, value_name = "COS")]
     normal_threshold: Option<f32>,
     /// Average K frames, each with a fresh VPL set (a still camera converges).
-    #[arg(
-        long,
-        allow_negative_numbers = true,
-        value_name = "K",
-        default_value_t = 1
-    )]
+    #[arg(long, value_name = "K", default_value_t = 1)]
     accumulate: u32,
 }
 
@@ -470,7 +460,7 @@ struct RenderArgs {
     #[arg(long, value_name = "EXR")]
     exr: Option<PathBuf>,
     /// Multiplier applied before tone mapping the PNG (the EXR stays unscaled).
-    #[arg(long, allow_negative_numbers = true, default_value_t = 1.0)]
+    #[arg(long, default_value_t = 1.0)]
     exposure: f32,
     /// Which buffer to write.
     #[arg(long, value_enum, default_value = "final")]
@@ -489,7 +479,7 @@ struct ViewArgs {
     #[command(flatten)]
     frame: FrameArgs,
     /// Multiplier applied before tone mapping (the panel changes it).
-    #[arg(long, allow_negative_numbers = true, default_value_t = 1.0)]
+    #[arg(long, default_value_t = 1.0)]
     exposure: f32,
     /// Which buffer to show first.
     #[arg(long, value_enum, default_value = "final")]
@@ -499,22 +489,17 @@ struct ViewArgs {
     #[arg(long, value_name = "FILE|TOML")]
     camera: Option<String>,
     /// Render N frames, then exit (with --screenshot: save it first).
-    #[arg(long, allow_negative_numbers = true, value_name = "N")]
+    #[arg(long, value_name = "N")]
     frames: Option<u32>,
     /// Where screenshots go: PNG at the panel's exposure, and the linear frame as EXR
     /// beside it (default: igi-screenshot-N.png in the working directory).
     #[arg(long, value_name = "PNG")]
     screenshot: Option<PathBuf>,
     /// Still frames averaged at most.
-    #[arg(long, allow_negative_numbers = true, default_value_t = 256)]
+    #[arg(long, default_value_t = 256)]
     max_accumulate: u32,
     /// Render at 1/S of the window's resolution (faster on slow adapters).
-    #[arg(
-        long,
-        allow_negative_numbers = true,
-        value_name = "S",
-        default_value_t = 1
-    )]
+    #[arg(long, value_name = "S", default_value_t = 1)]
     scale: u32,
     /// Draw the VPLs as dots.
     #[arg(long)]
@@ -1017,10 +1002,32 @@ fn no_wayland_for_headless_commands() {
     }
 }
 
+/// `cmd` and its subcommands, each option that takes a value taking a negative number as
+/// one (see [`parse_command_line`]). Flags take no value, and clap refuses the setting on
+/// them.
+fn negative_numbers_as_values(cmd: clap::Command) -> clap::Command {
+    cmd.mut_args(|a| {
+        let takes_value = a.get_action().takes_values();
+        a.allow_negative_numbers(takes_value)
+    })
+    .mut_subcommands(negative_numbers_as_values)
+}
+
+/// The command line, with a negative number taken as the value of the option before it:
+/// clap's default reads `--exposure -1` as a stray flag ("unexpected argument '-1'", with
+/// a tip to write `-- -1`), and a valid `--normal-threshold -0.5` needed `=`. Every
+/// option of every subcommand that takes a value gets the setting here, so that igi's own checks answer
+/// ("--exposure must be a positive number, got -1", or clap's "-5 is not in 0..=...").
+fn parse_command_line() -> Cli {
+    let mut cmd = negative_numbers_as_values(Cli::command());
+    let matches = cmd.get_matches_mut();
+    Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.format(&mut cmd).exit())
+}
+
 fn main() -> ExitCode {
     #[cfg(unix)]
     quiet_on_closed_pipes();
-    let cli = Cli::parse();
+    let cli = parse_command_line();
     #[cfg(unix)]
     if !matches!(cli.command, Command::View(_)) {
         no_wayland_for_headless_commands();
@@ -1069,4 +1076,17 @@ fn error_line(e: &anyhow::Error) -> String {
         .split_whitespace()
         .collect::<Vec<_>>()
         .join(" ")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_command_line_passes_clap_checks() {
+        // clap checks every subcommand's arguments when it builds them; a setting that
+        // does not fit an argument (as on a flag) panics only once that subcommand is
+        // used.
+        negative_numbers_as_values(Cli::command()).debug_assert();
+    }
 }
