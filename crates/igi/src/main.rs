@@ -591,6 +591,7 @@ fn view(args: &ViewArgs) -> Result<()> {
             Some(igi_core::scene::parse_camera_toml(&text, &name)?)
         }
     };
+    check_frame_args(&args.frame)?;
     let scene = load(&args.scene)?;
     let mut settings = settings(&scene, &args.frame)?;
     settings.exposure = args.exposure;
@@ -636,7 +637,9 @@ fn load(args: &SceneArgs) -> Result<Scene> {
     }
 }
 
-fn settings(scene: &Scene, f: &FrameArgs) -> Result<RenderSettings> {
+/// The frame options' own errors, which need no scene: checked before the scene is
+/// loaded (which can take seconds), and again by [`settings`].
+fn check_frame_args(f: &FrameArgs) -> Result<()> {
     if f.vpls == 0 {
         bail!("--vpls must be at least 1");
     }
@@ -657,6 +660,12 @@ fn settings(scene: &Scene, f: &FrameArgs) -> Result<RenderSettings> {
             bail!("--min-dist must be a positive number, got {m}");
         }
     }
+    f.accel.accelerations()?;
+    Ok(())
+}
+
+fn settings(scene: &Scene, f: &FrameArgs) -> Result<RenderSettings> {
+    check_frame_args(f)?;
     Ok(RenderSettings {
         width: f.width.unwrap_or(scene.film.width),
         height: f.height.unwrap_or(scene.film.height),
@@ -675,8 +684,9 @@ fn settings(scene: &Scene, f: &FrameArgs) -> Result<RenderSettings> {
     })
 }
 
-/// Every output of `igi render` checked before anything is rendered (see igi::outputs).
-fn check_render_outputs(args: &RenderArgs, scene: &Scene) -> Result<()> {
+/// Every output of `igi render` checked before anything is rendered (see igi::outputs):
+/// with no scene before it is loaded, then against the files it was read from.
+fn check_render_outputs(args: &RenderArgs, scene: Option<&Scene>) -> Result<()> {
     use igi::outputs::{Format, Output};
     let png = args.output.as_deref().map(|path| Output {
         option: "-o",
@@ -691,7 +701,7 @@ fn check_render_outputs(args: &RenderArgs, scene: &Scene) -> Result<()> {
         other: "write PNG with -o",
     });
     let outputs: Vec<Output> = png.into_iter().chain(exr).collect();
-    igi::outputs::check(&outputs, &scene.files)
+    igi::outputs::check(&outputs, scene.map_or(&[], |s| &s.files))
 }
 
 fn render(args: &RenderArgs) -> Result<()> {
@@ -704,11 +714,13 @@ fn render(args: &RenderArgs) -> Result<()> {
             args.exposure
         );
     }
+    check_frame_args(&args.frame)?;
+    check_render_outputs(args, None)?;
     let t = Instant::now();
     let scene = load(&args.scene)?;
     let load_ms = t.elapsed().as_secs_f64() * 1e3;
     let mut settings = settings(&scene, &args.frame)?;
-    check_render_outputs(args, &scene)?;
+    check_render_outputs(args, Some(&scene))?;
     settings.exposure = args.exposure;
     settings.output = output_buffer(args.buffer);
     let t = Instant::now();
@@ -836,18 +848,17 @@ fn bench_rays(args: &RaysArgs) -> Result<()> {
     if args.schedule == ScheduleArg::Refill && args.kind == RayKindArg::Closest {
         bail!("--schedule refill applies to shadow rays (any hit): give --kind shadow or both");
     }
+    let save = args.save.as_deref().map(|path| igi::outputs::Output {
+        option: "--save",
+        path,
+        format: igi::outputs::Format::Rays,
+        other: "",
+    });
+    // Before the scene is loaded and the rays are made, which can take long: a name that
+    // cannot be written is an error now, and one of the scene's files once it is known.
+    igi::outputs::check(save.as_slice(), &[])?;
     let scene = igi::bench::run::load(&args.scene)?;
-    if let Some(path) = &args.save {
-        // Before the rays are made, which can take long: a name that cannot be written,
-        // or that is one of the scene's files, is an error now.
-        let save = igi::outputs::Output {
-            option: "--save",
-            path,
-            format: igi::outputs::Format::Rays,
-            other: "",
-        };
-        igi::outputs::check(&[save], &scene.files)?;
-    }
+    igi::outputs::check(save.as_slice(), &scene.files)?;
     let t = Instant::now();
     let builder = args.bvh.builder.into();
     let bvh = Bvh::build_with(&scene.triangles, builder);

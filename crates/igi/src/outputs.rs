@@ -2,7 +2,7 @@
 //! cannot write every output writes none, and no output replaces an input or another
 //! output, or gets the other format's bytes under its name.
 
-use anyhow::{bail, Result};
+use anyhow::{bail, Context, Result};
 use std::path::{Path, PathBuf};
 
 /// What an output option writes.
@@ -54,7 +54,7 @@ pub fn check(outputs: &[Output], inputs: &[PathBuf]) -> Result<()> {
                 out.other
             );
         }
-        let target = igi_core::image::output_target(out.path)?;
+        let target = igi_core::image::output_target(out.path).context(out.option)?;
         if inputs.contains(&target) {
             bail!(
                 "{} {}: that is a file the scene was read from; give another output name",

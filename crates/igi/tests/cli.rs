@@ -138,6 +138,43 @@ fn negative_numbers_reach_the_checks() {
 }
 
 #[test]
+fn option_errors_come_before_the_scene_is_read() {
+    // Loading a large scene takes seconds: a mistyped option or output name is reported
+    // first, not after the load (these named the missing scene, or waited for it).
+    let d = temp_dir("errors-before-load");
+    let scene = d.join("no-such-scene.toml");
+    let scene = scene.to_str().unwrap();
+    let exr = d.join("x.exr");
+    let exr = exr.to_str().unwrap();
+    let bin = d.join("no-such-folder").join("rays.bin");
+    let bin = bin.to_str().unwrap();
+    for (args, words) in [
+        (vec!["render", scene, "-o", exr], vec!["-o", "not .exr"]),
+        (
+            vec!["render", scene, "--exr", exr, "--vpls", "0"],
+            vec!["--vpls must be at least 1"],
+        ),
+        (
+            vec!["render", scene, "--exr", exr, "--mirror-depth", "5000"],
+            vec!["--mirror-depth must be at most"],
+        ),
+        (
+            vec!["view", scene, "--bounces", "0"],
+            vec!["--bounces must be at least 1"],
+        ),
+        (
+            vec!["bench", "rays", scene, "--kind", "shadow", "--save", bin],
+            vec!["--save", "no-such-folder"],
+        ),
+    ] {
+        let out = igi(&args);
+        assert_one_error_line(&out, &words);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!stderr.contains("no-such-scene"), "{args:?}: {stderr}");
+    }
+}
+
+#[test]
 fn missing_files_other_than_scenes_are_named_in_words() {
     let d = temp_dir("missing-inputs");
     let nowhere = d.join("nowhere.exr");
@@ -335,11 +372,11 @@ fn bench_rays_checks_its_save_file_first() {
     for (save, words) in [
         (
             missing.to_str().unwrap(),
-            vec!["no/such/dir", "does not exist"],
+            vec!["--save", "no/such/dir", "does not exist"],
         ),
         (
             d.to_str().unwrap(),
-            vec!["cannot write", "a directory, not a regular file"],
+            vec!["--save", "cannot write", "a directory, not a regular file"],
         ),
         (
             scene.to_str().unwrap(),
@@ -1154,7 +1191,7 @@ fn a_bad_output_fails_the_run_before_any_output_is_written() {
         "--exr",
         good.to_str().unwrap(),
     ]);
-    assert_one_error_line(&out, &["missing-dir", "does not exist"]);
+    assert_one_error_line(&out, &["-o", "missing-dir", "does not exist"]);
     assert!(names_in(&d).is_empty(), "left {:?}", names_in(&d));
 }
 
