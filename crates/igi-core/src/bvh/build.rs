@@ -1302,6 +1302,23 @@ impl Sweep3 {
             self.lo[k] = self.lo[k].min(p.lo);
             self.hi[k] = self.hi[k].max(p.hi);
         }
+        self.half_areas()
+    }
+
+    /// Grows box k by `boxes[k]` (see [`Sweep3::grow`]).
+    #[inline]
+    fn grow_boxes(&mut self, boxes: [&Aabb; 3]) -> Vec3A {
+        for (k, b) in boxes.iter().enumerate() {
+            self.lo[k] = self.lo[k].min(b.lo);
+            self.hi[k] = self.hi[k].max(b.hi);
+        }
+        self.half_areas()
+    }
+
+    /// The three boxes' half areas (lane k: box k's), computed as [`Aabb::half_area`]
+    /// computes them.
+    #[inline]
+    fn half_areas(&self) -> Vec3A {
         let e = |k: usize| (self.hi[k] - self.lo[k]).max(Vec3A::ZERO);
         let t = glam::Mat3A::from_cols(e(0), e(1), e(2)).transpose();
         let (ex, ey, ez) = (t.x_axis, t.y_axis, t.z_axis);
@@ -1356,35 +1373,38 @@ fn find_split(prims: &[PrimRef], cbounds: &Aabb, parallel: bool) -> Option<Split
     } else {
         bin_range(prims, &binner)
     };
+    // The three axes' sweeps side by side (Sweep3), with the same costs to the bit as one
+    // axis after another. A split with nothing on one side, or on an axis without
+    // extent, costs infinity: it is never taken, as it was never considered.
+    let lanes = |k: [u32; 3]| Vec3A::new(k[0] as f32, k[1] as f32, k[2] as f32);
+    let no_extent = binner.scale.cmpeq(Vec3A::ZERO);
+    // right_cost[i]: bins i+1.. as the right child.
+    let mut right_cost = [Vec3A::ZERO; SAH_BINS];
+    let mut sweep = Sweep3::default();
+    let mut count = [0u32; 3];
+    for i in (1..nb).rev() {
+        let area = sweep.grow_boxes([0, 1, 2].map(|axis| &bins[axis][i]));
+        count = [0, 1, 2].map(|axis| count[axis] + counts[axis][i]);
+        let n = lanes(count);
+        right_cost[i - 1] = Vec3A::select(n.cmpeq(Vec3A::ZERO), Vec3A::INFINITY, area * n);
+    }
+    let mut cost = [Vec3A::ZERO; SAH_BINS];
+    let mut sweep = Sweep3::default();
+    let mut count = [0u32; 3];
+    for i in 0..nb - 1 {
+        let area = sweep.grow_boxes([0, 1, 2].map(|axis| &bins[axis][i]));
+        count = [0, 1, 2].map(|axis| count[axis] + counts[axis][i]);
+        let n = lanes(count);
+        let skip = n.cmpeq(Vec3A::ZERO) | no_extent;
+        cost[i] = Vec3A::select(skip, Vec3A::INFINITY, area * n + right_cost[i]);
+    }
+    // The first lowest cost in axis order, then bin order.
     let mut best: Option<(usize, u32, f32)> = None;
     for axis in 0..3 {
-        if binner.scale[axis] == 0.0 {
-            continue;
-        }
-        // right_cost[i]: bins i+1.. as the right child.
-        let mut right_cost = [0.0f32; SAH_BINS];
-        let mut acc = Aabb::EMPTY;
-        let mut count = 0u32;
-        for i in (1..nb).rev() {
-            acc.grow(&bins[axis][i]);
-            count += counts[axis][i];
-            right_cost[i - 1] = if count > 0 {
-                acc.half_area() * count as f32
-            } else {
-                f32::INFINITY
-            };
-        }
-        let mut acc = Aabb::EMPTY;
-        let mut count = 0u32;
-        for i in 0..nb - 1 {
-            acc.grow(&bins[axis][i]);
-            count += counts[axis][i];
-            if count == 0 {
-                continue;
-            }
-            let cost = acc.half_area() * count as f32 + right_cost[i];
-            if cost < best.map_or(f32::INFINITY, |b| b.2) {
-                best = Some((axis, i as u32 + 1, cost));
+        for (i, c) in cost[..nb - 1].iter().enumerate() {
+            let c: [f32; 4] = bytemuck::cast(*c);
+            if c[axis] < best.map_or(f32::INFINITY, |b| b.2) {
+                best = Some((axis, i as u32 + 1, c[axis]));
             }
         }
     }
@@ -1590,6 +1610,88 @@ mod small_sweep_tests {
         (best.0, best.1, best.2, orders)
     }
 
+    /// `find_split`'s sweep over the bins as written first: one axis after another.
+    fn reference_split(prims: &[PrimRef], cbounds: &Aabb) -> Option<(usize, u32, f32)> {
+        let nb = bin_count(prims.len());
+        let binner = Binner::new(cbounds, nb);
+        let (bins, counts) = bin_range(prims, &binner);
+        let mut best: Option<(usize, u32, f32)> = None;
+        for axis in 0..3 {
+            if binner.scale[axis] == 0.0 {
+                continue;
+            }
+            let mut right_cost = [0.0f32; SAH_BINS];
+            let mut acc = Aabb::EMPTY;
+            let mut count = 0u32;
+            for i in (1..nb).rev() {
+                acc.grow(&bins[axis][i]);
+                count += counts[axis][i];
+                right_cost[i - 1] = if count > 0 {
+                    acc.half_area() * count as f32
+                } else {
+                    f32::INFINITY
+                };
+            }
+            let mut acc = Aabb::EMPTY;
+            let mut count = 0u32;
+            for (i, right) in right_cost[..nb - 1].iter().enumerate() {
+                acc.grow(&bins[axis][i]);
+                count += counts[axis][i];
+                if count == 0 {
+                    continue;
+                }
+                let cost = acc.half_area() * count as f32 + right;
+                if cost < best.map_or(f32::INFINITY, |b| b.2) {
+                    best = Some((axis, i as u32 + 1, cost));
+                }
+            }
+        }
+        best
+    }
+
+    /// Random boxes on a grid (coarse grids make equal centroids), some flat.
+    fn random_prims(r: &mut Pcg64, n: usize, grid: f32) -> Vec<PrimRef> {
+        (0..n)
+            .map(|_| {
+                let mut v = || r.random_range(0.0..grid).floor();
+                let lo = Vec3A::new(v(), v(), v());
+                let size = Vec3A::new(v(), v(), v()) * r.random_range(0.0..2.0f32);
+                let flat = r.random_range(0..4);
+                let size = if flat < 3 {
+                    Vec3A::select(Vec3A::AXES[flat].cmpeq(Vec3A::ONE), Vec3A::ZERO, size)
+                } else {
+                    size
+                };
+                PrimRef { lo, hi: lo + size }
+            })
+            .collect()
+    }
+
+    /// `find_split` with the three axes' bins swept side by side picks the split of the
+    /// one-axis-at-a-time sweep, with the same cost to the bit, for both bin counts,
+    /// with empty bins, axes without extent, and ranges whose centroids are all equal.
+    #[test]
+    fn bin_sweep_matches_the_one_axis_sweep() {
+        let mut r = Pcg64::seed_from_u64(12);
+        for case in 0..3_000 {
+            let n = [13, 40, 255, 256, 700][case % 5];
+            let grid = [1.0, 3.0, 50.0, 1e4][case % 4];
+            let mut prims = random_prims(&mut r, n, grid);
+            if case % 7 == 0 {
+                // One axis without extent: every centroid at the same x.
+                for p in &mut prims {
+                    let w = p.hi.x - p.lo.x;
+                    (p.lo.x, p.hi.x) = (-w, w);
+                }
+            }
+            let (_, cbounds) = range_bounds(&prims);
+            let split = find_split(&prims, &cbounds, false);
+            let got = split.map(|s| (s.axis, s.bin, s.cost.to_bits()));
+            let want = reference_split(&prims, &cbounds).map(|(a, b, c)| (a, b, c.to_bits()));
+            assert_eq!(got, want, "case {case}");
+        }
+    }
+
     /// The three-axes-at-once sweep (`Sweep3`) picks the split the one-axis-at-a-time
     /// sweep picks, with the same cost to the bit, on ranges of every small size, with
     /// equal centroids, flat and point-like boxes among them.
@@ -1599,20 +1701,7 @@ mod small_sweep_tests {
         for case in 0..20_000 {
             let n = 3 + case % (SMALL_RANGE - 2);
             let grid = [1.0, 4.0, 1000.0][case % 3]; // coarse grids make equal centroids
-            let prims: Vec<PrimRef> = (0..n)
-                .map(|_| {
-                    let mut v = || (r.random_range(0.0..grid) as f32).floor();
-                    let lo = Vec3A::new(v(), v(), v());
-                    let size = Vec3A::new(v(), v(), v()) * r.random_range(0.0..2.0f32);
-                    let flat = r.random_range(0..4);
-                    let size = if flat < 3 {
-                        Vec3A::select(Vec3A::AXES[flat].cmpeq(Vec3A::ONE), Vec3A::ZERO, size)
-                    } else {
-                        size
-                    };
-                    PrimRef { lo, hi: lo + size }
-                })
-                .collect();
+            let prims = random_prims(&mut r, n, grid);
             let sweep = SmallSweep::new(&prims);
             let (axis, at, cost, orders) = reference(&prims);
             assert_eq!(
