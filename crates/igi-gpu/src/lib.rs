@@ -15,4 +15,4 @@ pub mod scene_buffers;
 pub mod shader;
 
 pub use context::{AdapterChoice, GpuContext, GpuError};
-pub use frame::{FrameOutput, Renderer};
+pub use frame::{FrameOutput, Passes, Renderer};

@@ -114,6 +114,17 @@ impl SceneBuffers {
     }
 
     pub fn upload(ctx: &GpuContext, scene: &Scene, bvh: &Bvh) -> Result<SceneBuffers, GpuError> {
+        Self::upload_with(ctx, Self::layout(&ctx.device), scene, bvh)
+    }
+
+    /// As [`SceneBuffers::upload`], bound with `layout` (made by [`SceneBuffers::layout`]:
+    /// the one the passes' pipelines were made with).
+    pub fn upload_with(
+        ctx: &GpuContext,
+        layout: wgpu::BindGroupLayout,
+        scene: &Scene,
+        bvh: &Bvh,
+    ) -> Result<SceneBuffers, GpuError> {
         let shading: Vec<TriShading> = bvh
             .tri_order
             .iter()
@@ -153,7 +164,6 @@ impl SceneBuffers {
         for _ in 0..SPARE_COUNTERS {
             spare_counters.push(storage_buffer(ctx, "spare ray counters", &[0u8; 32])?);
         }
-        let layout = Self::layout(&ctx.device);
         let group = |label: &str, counters: &wgpu::Buffer| {
             let entries: Vec<wgpu::BindGroupEntry> = buffers
                 .iter()

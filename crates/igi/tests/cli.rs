@@ -175,6 +175,37 @@ fn option_errors_come_before_the_scene_is_read() {
 }
 
 #[test]
+fn render_reports_the_scene_before_the_adapter() {
+    // The GPU's set-up runs on a thread of its own while the scene loads: a scene that
+    // cannot be read is still the error reported (it was first before), and a bad
+    // adapter with a good scene is one error line, with no output written.
+    let d = temp_dir("gpu-beside-load");
+    let png = d.join("x.png");
+    let png = png.to_str().unwrap();
+    let missing = d.join("no-such-scene.toml");
+    let out = igi(&[
+        "render",
+        missing.to_str().unwrap(),
+        "--adapter",
+        "no-such-adapter",
+        "-o",
+        png,
+    ]);
+    assert_one_error_line(&out, &["no-such-scene.toml"]);
+    let out = igi(&[
+        "render",
+        "--builtin",
+        "cornell-box",
+        "--adapter",
+        "no-such-adapter",
+        "-o",
+        png,
+    ]);
+    assert_one_error_line(&out, &["no adapter matches 'no-such-adapter'"]);
+    assert!(!d.join("x.png").exists());
+}
+
+#[test]
 fn missing_files_other_than_scenes_are_named_in_words() {
     let d = temp_dir("missing-inputs");
     let nowhere = d.join("nowhere.exr");
