@@ -338,12 +338,18 @@ impl GpuContext {
         }
     }
 
+    /// Whether the adapter is a software one (lavapipe / llvmpipe): what the passes'
+    /// loop limits, the mirror lanes and the ray schedules depend on.
+    pub fn is_software(&self) -> bool {
+        self.info.device_type == wgpu::DeviceType::Cpu
+    }
+
     /// VPLs one gathering dispatch may take. A software adapter (llvmpipe) ends a shader
     /// invocation after 65535 loop iterations in all, and each VPL is a BVH traversal of
     /// up to a few thousand iterations, so there the VPL list is split into ranges of
     /// this many; a GPU takes the whole list at once.
     pub fn vpls_per_dispatch(&self) -> u32 {
-        if self.info.device_type == wgpu::DeviceType::Cpu {
+        if self.is_software() {
             SOFTWARE_VPLS_PER_DISPATCH
         } else {
             u32::MAX

@@ -111,13 +111,17 @@ pub struct Passes {
 impl Passes {
     pub fn new(ctx: &GpuContext) -> Passes {
         let device = &ctx.device;
-        let software = ctx.info.device_type == wgpu::DeviceType::Cpu;
         let layout = SceneBuffers::layout(device);
         let range_layout = gather_range_layout(device);
         Passes {
             vpl: VplPass::new(device, &layout),
             direct: DirectPass::new(device, &layout, &range_layout),
-            indirect: IndirectPass::new(device, &layout, &range_layout, mirror_lanes(software)),
+            indirect: IndirectPass::new(
+                device,
+                &layout,
+                &range_layout,
+                mirror_lanes(ctx.is_software()),
+            ),
             filter: FilterPass::new(device, &layout),
             compose: ComposePass::new(device, &layout),
             scene_layout: layout,
@@ -235,7 +239,6 @@ impl Renderer {
         // One pass over the triangles for both figures of the scene's size.
         let (lo, hi) = scene.bounds();
         warn_large_min_dist(scene, igi_core::scene::diagonal_of(lo, hi));
-        let software = ctx.info.device_type == wgpu::DeviceType::Cpu;
         let renderer = Renderer {
             vpl,
             direct,
@@ -276,7 +279,7 @@ impl Renderer {
             ray_offset_floor: igi_core::bvh::offset_floor(lo, hi),
             path_cache: None,
             counting: false,
-            software,
+            software: ctx.is_software(),
             has_mirrors: scene.materials.iter().any(|m| m.mirror.max_element() > 0.0),
         };
         ctx.check()?;

@@ -48,7 +48,7 @@ pub enum RaySchedule {
 /// 8 M more and 60.3 M frame rays was answered as one ray per thread answers it
 /// (docs/PERFORMANCE.md attempt 110).
 pub fn refill_offered(ctx: &GpuContext) -> bool {
-    ctx.subgroups && ctx.info.device_type != wgpu::DeviceType::Cpu
+    ctx.subgroups && !ctx.is_software()
 }
 
 impl RaySchedule {

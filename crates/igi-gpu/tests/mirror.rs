@@ -200,7 +200,7 @@ fn mirrored_hits_gather_from_all_vpls() {
         checked > 200,
         "the floor should fill the bottom of the image: {checked}"
     );
-    let software = gpu().is_some_and(|c| c.info.device_type == wgpu::DeviceType::Cpu);
+    let software = gpu().is_some_and(|c| c.is_software());
     let per_group = list_pixels_per_group(mirror_lanes(software));
     assert!(
         checked > per_group,

@@ -1307,7 +1307,9 @@ impl Sweep3 {
         self.half_areas()
     }
 
-    /// Grows box k by `boxes[k]` (see [`Sweep3::grow`]).
+    /// Grows box k by `boxes[k]` (see [`Sweep3::grow`]). Not one generic method for
+    /// both: with the primitives' indexing outside the loop, or through a closure, the
+    /// build took 956-958 M instructions against 948 M.
     #[inline]
     fn grow_boxes(&mut self, boxes: [&Aabb; 3]) -> Vec3A {
         for (k, b) in boxes.iter().enumerate() {
