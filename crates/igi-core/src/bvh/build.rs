@@ -1188,45 +1188,62 @@ struct SmallSweep {
 }
 
 impl SmallSweep {
+    /// The sweep of a range of 2..=SMALL_RANGE primitives: one copy of the code per size,
+    /// so that every loop has a fixed count and unrolls, and the best split is picked
+    /// without branches (948 -> 918 M instructions a build, the same trees;
+    /// docs/PERFORMANCE.md attempt 118).
     fn new(prims: &[PrimRef]) -> SmallSweep {
-        let n = prims.len();
-        debug_assert!((2..=SMALL_RANGE).contains(&n));
-        let mut sweep = SmallSweep {
-            n,
+        const _: () = assert!(SMALL_RANGE == 12, "one arm per size below");
+        match prims.len() {
+            2 => Self::pair(prims),
+            3 => Self::of::<3>(prims),
+            4 => Self::of::<4>(prims),
+            5 => Self::of::<5>(prims),
+            6 => Self::of::<6>(prims),
+            7 => Self::of::<7>(prims),
+            8 => Self::of::<8>(prims),
+            9 => Self::of::<9>(prims),
+            10 => Self::of::<10>(prims),
+            11 => Self::of::<11>(prims),
+            _ => Self::of::<12>(prims),
+        }
+    }
+
+    /// Two primitives: one per side whatever the axis.
+    fn pair(prims: &[PrimRef]) -> SmallSweep {
+        let half_area = |p: &PrimRef| Aabb { lo: p.lo, hi: p.hi }.half_area();
+        let mut order = [[0; SMALL_RANGE]; 3];
+        order[0][1] = 1;
+        SmallSweep {
+            n: 2,
             axis: 0,
             at: 0,
-            cost: f32::INFINITY,
-            order: [[0; SMALL_RANGE]; 3],
-        };
-        let boxes = |k: u8| {
-            let p = &prims[k as usize];
-            Aabb { lo: p.lo, hi: p.hi }
-        };
-        if n == 2 {
-            // One primitive per side whatever the axis.
-            sweep.order[0][1] = 1;
-            sweep.cost = boxes(0).half_area() + boxes(1).half_area();
-            return sweep;
+            cost: half_area(&prims[0]) + half_area(&prims[1]),
+            order,
         }
-        let mut c = [Vec3A::ZERO; SMALL_RANGE];
-        for (ci, p) in c.iter_mut().zip(prims) {
-            *ci = p.centroid2();
-        }
+    }
+
+    /// The sweep of `N` primitives (3..=SMALL_RANGE).
+    #[inline(always)]
+    fn of<const N: usize>(prims: &[PrimRef]) -> SmallSweep {
+        let prims: &[PrimRef; N] = prims.try_into().expect("N primitives");
+        let mut order = [[0u8; SMALL_RANGE]; 3];
+        let c: [Vec3A; N] = std::array::from_fn(|i| prims[i].centroid2());
         // Rank of each primitive along each axis (ties by index, so equal centroids are
         // split by index): branch-free, all three axes at once. Those before i in index
         // order count when not greater, those after when less.
-        for i in 0..n {
+        for i in 0..N {
             let mut r = Vec3A::ZERO;
             for cj in &c[..i] {
                 r += Vec3A::select(cj.cmple(c[i]), Vec3A::ONE, Vec3A::ZERO);
             }
-            for cj in &c[i + 1..n] {
+            for cj in &c[i + 1..] {
                 r += Vec3A::select(cj.cmplt(c[i]), Vec3A::ONE, Vec3A::ZERO);
             }
             // The ranks (< 16) as integers by ROUND_MAGIC, not a saturating cast; the lanes
             // through an array, not glam's Vec3A indexing (which goes through memory).
             let ranks: [u32; 4] = bytemuck::cast(r + Vec3A::splat(ROUND_MAGIC));
-            for (order, r) in sweep.order.iter_mut().zip(ranks) {
+            for (order, r) in order.iter_mut().zip(ranks) {
                 order[(r & 15) as usize] = i as u8;
             }
         }
@@ -1234,44 +1251,72 @@ impl SmallSweep {
         // primitive, and the three half areas are taken at once from the boxes' extents
         // transposed into lanes (x, y and z of the three boxes), with the operations of
         // `Aabb::half_area` in its order, so the costs are the same bits.
-        let order = &sweep.order;
-        let mut right = [Vec3A::ZERO; SMALL_RANGE];
+        let mut right = [Vec3A::ZERO; N];
         let mut sweep3 = Sweep3::default();
-        for i in (1..n).rev() {
-            right[i - 1] = sweep3.grow(prims, order, i) * (n - i) as f32;
+        for i in (1..N).rev() {
+            right[i - 1] = sweep3.grow(prims, &order, i) * (N - i) as f32;
         }
-        let mut cost = [Vec3A::ZERO; SMALL_RANGE];
+        // Per axis the first lowest cost in split order (lanes take a cost only when
+        // strictly lower), then the first lowest in axis order: what the sweeps one axis
+        // after another found.
+        let mut best = Vec3A::INFINITY;
+        let mut best_at = Vec3A::ZERO;
         let mut sweep3 = Sweep3::default();
-        for i in 0..n - 1 {
-            cost[i] = sweep3.grow(prims, order, i) * (i + 1) as f32 + right[i];
+        for (i, right) in right[..N - 1].iter().enumerate() {
+            let cost = sweep3.grow(prims, &order, i) * (i + 1) as f32 + *right;
+            let lower = cost.cmplt(best);
+            best = Vec3A::select(lower, cost, best);
+            best_at = Vec3A::select(lower, Vec3A::splat(i as f32), best_at);
         }
-        // The first lowest cost in axis order, then split order, as the sweeps one axis
-        // after another found it.
-        for axis in 0..3 {
-            for (i, c) in cost[..n - 1].iter().enumerate() {
-                let c: [f32; 4] = bytemuck::cast(*c);
-                if c[axis] < sweep.cost {
-                    (sweep.axis, sweep.at, sweep.cost) = (axis, i, c[axis]);
-                }
+        let (mut axis, mut cost) = (0, f32::INFINITY);
+        for k in 0..3 {
+            if best[k] < cost {
+                (axis, cost) = (k, best[k]);
             }
         }
-        sweep
+        SmallSweep {
+            n: N,
+            axis,
+            at: if cost < f32::INFINITY {
+                best_at[axis] as usize
+            } else {
+                0
+            },
+            cost,
+            order,
+        }
     }
 
     /// Reorders the range by the chosen axis; returns the left count and the bounds and
     /// centroid bounds of both sides.
     fn apply(&self, prims: &mut [PrimRef], ids: &mut [u32]) -> (usize, Aabb, Aabb, Aabb, Aabb) {
-        let n = self.n;
-        let (mut p, mut d) = ([prims[0]; SMALL_RANGE], [0u32; SMALL_RANGE]);
-        for (i, &o) in self.order[self.axis].iter().take(n).enumerate() {
-            p[i] = prims[o as usize];
-            d[i] = ids[o as usize];
+        let (n, k) = (self.n, self.at + 1);
+        let order = &self.order[self.axis][..n];
+        // The primitives in their new order, with the bounds of each side taken on the
+        // way; left unwritten beyond n (filling the 12 places first cost more than the
+        // rest of the reordering).
+        let mut p = [MaybeUninit::<PrimRef>::uninit(); SMALL_RANGE];
+        let mut d = [0u32; SMALL_RANGE];
+        let mut gather = |places: std::ops::Range<usize>| {
+            let (mut b, mut c) = (Aabb::EMPTY, Aabb::EMPTY);
+            for i in places {
+                let o = order[i] as usize;
+                let q = prims[o];
+                b.lo = b.lo.min(q.lo);
+                b.hi = b.hi.max(q.hi);
+                c.grow_point(q.centroid2());
+                p[i].write(q);
+                d[i] = ids[o];
+            }
+            (b, c)
+        };
+        let (lb, lc) = gather(0..k);
+        let (rb, rc) = gather(k..n);
+        for (to, from) in prims.iter_mut().zip(&p) {
+            // SAFETY: the two gathers wrote places 0..n, and prims has n.
+            *to = unsafe { from.assume_init() };
         }
-        prims.copy_from_slice(&p[..n]);
         ids.copy_from_slice(&d[..n]);
-        let k = self.at + 1;
-        let (lb, lc) = range_bounds(&prims[..k]);
-        let (rb, rc) = range_bounds(&prims[k..]);
         (k, lb, lc, rb, rc)
     }
 }
@@ -1333,9 +1378,12 @@ impl Sweep3 {
 /// Bounds and primitive counts of the bins, per axis.
 type Bins = ([[Aabb; SAH_BINS]; 3], [[u32; SAH_BINS]; 3]);
 
-fn bin_range(prims: &[PrimRef], binner: &Binner) -> Bins {
-    let mut bins = [[Aabb::EMPTY; SAH_BINS]; 3];
-    let mut counts = [[0u32; SAH_BINS]; 3];
+/// Empty bins: every box [`Aabb::EMPTY`], every count 0.
+const NO_BINS: Bins = ([[Aabb::EMPTY; SAH_BINS]; 3], [[0; SAH_BINS]; 3]);
+
+/// Adds the primitives of a range to `bins` (in place: bins returned by value were copied
+/// out, 2 M instructions of a build).
+fn bin_range(prims: &[PrimRef], binner: &Binner, (bins, counts): &mut Bins) {
     for p in prims {
         let b = binner.bins(p.centroid2());
         for axis in 0..3 {
@@ -1346,7 +1394,6 @@ fn bin_range(prims: &[PrimRef], binner: &Binner) -> Bins {
             counts[axis][k] += 1;
         }
     }
-    (bins, counts)
 }
 
 /// Best SAH split of a range over [`SAH_BINS`] bins per axis, or None when all
@@ -1354,29 +1401,28 @@ fn bin_range(prims: &[PrimRef], binner: &Binner) -> Bins {
 fn find_split(prims: &[PrimRef], cbounds: &Aabb, parallel: bool) -> Option<Split> {
     let nb = bin_count(prims.len());
     let binner = Binner::new(cbounds, nb);
-    let (bins, counts) = if parallel && threads() > 1 {
+    let mut bins = NO_BINS;
+    if parallel && threads() > 1 {
         let chunk = prims.len().div_ceil(threads());
-        let mut parts: Vec<Option<Bins>> = prims.chunks(chunk).map(|_| None).collect();
+        let mut parts: Vec<Bins> = prims.chunks(chunk).map(|_| NO_BINS).collect();
         let binner = &binner;
         rayon_core::scope(|s| {
             for (c, part) in prims.chunks(chunk).zip(&mut parts) {
-                s.spawn(move |_| *part = Some(bin_range(c, binner)));
+                s.spawn(move |_| bin_range(c, binner, part));
             }
         });
-        let mut parts = parts.into_iter().map(|p| p.expect("every chunk ran"));
-        let (mut bins, mut counts) = parts.next().expect("at least one chunk");
-        for (b, c) in parts {
+        for (b, c) in &parts {
             for axis in 0..3 {
                 for k in 0..nb {
-                    bins[axis][k].grow(&b[axis][k]);
-                    counts[axis][k] += c[axis][k];
+                    bins.0[axis][k].grow(&b[axis][k]);
+                    bins.1[axis][k] += c[axis][k];
                 }
             }
         }
-        (bins, counts)
     } else {
-        bin_range(prims, &binner)
-    };
+        bin_range(prims, &binner, &mut bins);
+    }
+    let (bins, counts) = (&bins.0, &bins.1);
     // The three axes' sweeps side by side (Sweep3), with the same costs to the bit as one
     // axis after another. A split with nothing on one side, or on an axis without
     // extent, costs infinity: it is never taken, as it was never considered.
@@ -1618,7 +1664,9 @@ mod sweep_tests {
     fn reference_split(prims: &[PrimRef], cbounds: &Aabb) -> Option<(usize, u32, f32)> {
         let nb = bin_count(prims.len());
         let binner = Binner::new(cbounds, nb);
-        let (bins, counts) = bin_range(prims, &binner);
+        let mut bins = NO_BINS;
+        bin_range(prims, &binner, &mut bins);
+        let (bins, counts) = bins;
         let mut best: Option<(usize, u32, f32)> = None;
         for axis in 0..3 {
             if binner.scale[axis] == 0.0 {
