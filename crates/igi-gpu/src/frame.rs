@@ -286,6 +286,20 @@ impl Renderer {
         Ok(renderer)
     }
 
+    /// The renderer's passes back, for the next scene's renderer ([`Renderer::with_passes`]):
+    /// a command that renders several scenes makes the pipelines once.
+    pub fn into_passes(self) -> Passes {
+        Passes {
+            scene_layout: self.scene.layout,
+            range_layout: self.range_layout,
+            vpl: self.vpl,
+            direct: self.direct,
+            indirect: self.indirect,
+            filter: self.filter,
+            compose: self.compose,
+        }
+    }
+
     /// The most workgroups of the mirror gather and of the direct pass's later walks
     /// from the next frame on (at least one per bucket): fewer than the lists need make
     /// each workgroup take several parts of its list, which is what a larger image does

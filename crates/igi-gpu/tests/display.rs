@@ -1,6 +1,7 @@
 //! What the viewer (`igi view`) relies on, without a window: the normals and depth
 //! buffers, moving lights and the camera between frames, and the display pass drawing the
-//! frame exactly as a PNG file of it would look (plus the VPL dots where the VPLs are).
+//! frame exactly as a PNG file of it would look (plus the VPL dots where the VPLs are);
+//! and what `igi bench` relies on: a renderer's passes handed to the next scene's.
 
 mod common;
 
@@ -96,6 +97,45 @@ fn moved_light_and_camera_match_a_fresh_renderer() {
     // A different number of lights is refused with a message.
     let e = renderer.set_lights(&ctx, &[]).unwrap_err().to_string();
     assert!(e.contains("0 lights given") && e.contains("has 1"), "{e}");
+}
+
+/// The passes of a renderer that drew one scene, handed to a renderer of another scene
+/// (as `igi bench` does with several scenes), give that scene's frame bit for bit as a
+/// renderer with passes of its own does: the passes keep nothing of the first scene.
+#[test]
+fn passes_handed_on_render_the_next_scene_as_new_ones() {
+    let Some(ctx) = gpu() else { return };
+    let first = mirror_floor(Vec3::splat(0.3), Vec3::splat(0.5));
+    let first_settings = RenderSettings {
+        width: 36,
+        height: 28,
+        vpls: 40,
+        mirror_depth: 2,
+        ..RenderSettings::default()
+    };
+    let bvh = Bvh::build(&first.triangles);
+    let mut renderer = Renderer::new(&ctx, &first, &bvh).expect("renderer");
+    let first_frame = renderer.render(&ctx, &first_settings).expect("frame");
+    let mut passes = Some(renderer.into_passes());
+    let next = builtin_scene("cornell-box").expect("built-in");
+    for setup in ["canonical", "iv+ds+il"] {
+        let settings = RenderSettings {
+            width: 40,
+            height: 32,
+            vpls: 24,
+            accelerations: igi_core::settings::Accelerations::from_setup(setup).unwrap(),
+            ..RenderSettings::default()
+        };
+        let fresh = render(&ctx, &next, &settings);
+        assert_ne!(fresh.image.data.len(), first_frame.image.data.len());
+        let bvh = Bvh::build(&next.triangles);
+        let handed = passes.take().expect("handed back");
+        let mut renderer = Renderer::with_passes(&ctx, handed, &next, &bvh).expect("renderer");
+        let handed_on = renderer.render(&ctx, &settings).expect("frame");
+        assert_eq!(handed_on.vpl_count, fresh.vpl_count, "{setup}");
+        assert_eq!(handed_on.image.data, fresh.image.data, "{setup}");
+        passes = Some(renderer.into_passes());
+    }
 }
 
 /// Draw the renderer's last frame with the display pass into a `width` x `height` texture

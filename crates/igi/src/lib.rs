@@ -1,6 +1,7 @@
 //! The igi command's library part: what `igi bench` measures and how it is reported.
 
 pub mod bench;
+pub mod gpu_set_up;
 pub mod outputs;
 pub mod view;
 

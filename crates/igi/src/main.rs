@@ -10,7 +10,7 @@ use igi_core::settings::{
     Accelerations, FilterMode, GeometryBound, InterleavePattern, OutputBuffer, RenderSettings,
     MAX_MIRROR_DEPTH,
 };
-use igi_gpu::{AdapterChoice, GpuContext, Passes, Renderer};
+use igi_gpu::{AdapterChoice, GpuContext, Renderer};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
@@ -704,52 +704,6 @@ fn check_render_outputs(args: &RenderArgs, scene: Option<&Scene>) -> Result<()> 
     igi::outputs::check(&outputs, scene.map_or(&[], |s| &s.files))
 }
 
-/// The GPU's set-up (adapter, device and the passes' pipelines), started on a thread of
-/// its own so that it runs while the scene loads, which keeps one core busy: on the H200
-/// it takes about 0.3 s with the driver's shader cache warm (as long as loading the
-/// conference room), on lavapipe about 0.7 s. It is always joined, also when the scene
-/// fails (exiting while the thread is inside the GPU driver could crash there); then
-/// [`GpuSetUp::abandon`] spares it the pipelines, most of its time.
-struct GpuSetUp {
-    thread: std::thread::JoinHandle<Result<Option<(GpuContext, Passes)>, igi_gpu::GpuError>>,
-    abandoned: std::sync::Arc<std::sync::atomic::AtomicBool>,
-}
-
-fn gpu_set_up_beside(adapter: Option<String>) -> Result<GpuSetUp> {
-    let abandoned = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
-    let flag = abandoned.clone();
-    let thread = std::thread::Builder::new()
-        .name("gpu set-up".into())
-        .spawn(move || {
-            let ctx = GpuContext::new(&AdapterChoice::from_option(adapter.as_deref()))?;
-            if flag.load(std::sync::atomic::Ordering::Relaxed) {
-                return Ok(None);
-            }
-            let passes = Passes::new(&ctx);
-            Ok(Some((ctx, passes)))
-        })
-        .context("cannot start the GPU set-up thread")?;
-    Ok(GpuSetUp { thread, abandoned })
-}
-
-impl GpuSetUp {
-    fn join(self) -> Result<(GpuContext, Passes)> {
-        match self.thread.join() {
-            Ok(Ok(Some(set_up))) => Ok(set_up),
-            Ok(Ok(None)) => bail!("the GPU set-up was abandoned"),
-            Ok(Err(e)) => Err(e.into()),
-            Err(_) => bail!("the GPU set-up failed (its thread panicked)"),
-        }
-    }
-
-    /// Waits for the thread after telling it to skip what it has not begun.
-    fn abandon(self) {
-        self.abandoned
-            .store(true, std::sync::atomic::Ordering::Relaxed);
-        let _ = self.thread.join();
-    }
-}
-
 fn render(args: &RenderArgs) -> Result<()> {
     if args.output.is_none() && args.exr.is_none() {
         bail!("nothing to write: give -o OUT.png and/or --exr OUT.exr");
@@ -762,7 +716,7 @@ fn render(args: &RenderArgs) -> Result<()> {
     }
     check_frame_args(&args.frame)?;
     check_render_outputs(args, None)?;
-    let gpu = gpu_set_up_beside(args.frame.adapter.clone())?;
+    let gpu = igi::gpu_set_up::GpuSetUp::start(args.frame.adapter.clone())?;
     let t = Instant::now();
     let loaded = load(&args.scene).and_then(|scene| {
         let load_ms = t.elapsed().as_secs_f64() * 1e3;

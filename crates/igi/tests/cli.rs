@@ -338,9 +338,13 @@ fn skipped_for_no_adapter(out: &Output) -> bool {
 #[test]
 fn bench_runs_tiny_and_its_json_parses() {
     let d = temp_dir("bench");
+    // Two scenes: the second renderer gets the passes of the first.
+    let quad_dir = temp_dir("bench-quad");
+    let quad = scene_with_obj(&quad_dir, QUAD);
     let out = igi(&[
         "bench",
         "builtin:cornell-box",
+        quad.to_str().unwrap(),
         "--width",
         "32",
         "--height",
@@ -368,7 +372,11 @@ fn bench_runs_tiny_and_its_json_parses() {
     let text = std::fs::read_to_string(d.join("results.json")).unwrap();
     // Every field present: the typed parse fails on a missing one.
     let results: igi::bench::model::BenchResults = serde_json::from_str(&text).unwrap();
-    assert_eq!(results.runs.len(), 1);
+    assert_eq!(results.runs.len(), 2);
+    let quad_run = &results.runs[1];
+    assert_eq!(quad_run.scene_path, quad.to_str().unwrap());
+    assert_eq!(quad_run.triangles, 2);
+    assert!(quad_run.frame.median_ms > 0.0 && d.join(&quad_run.image_exr).exists());
     let run = &results.runs[0];
     assert_eq!(
         (run.width, run.height, run.setup.as_str()),

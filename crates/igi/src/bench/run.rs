@@ -3,13 +3,14 @@
 //! timestamp queries, with ray counts, memory, and the image error against a reference.
 
 use super::model::*;
+use crate::gpu_set_up::GpuSetUp;
 use anyhow::{bail, Context, Result};
 use igi_core::bvh::Bvh;
 use igi_core::image::{rel_mse, Image};
 use igi_core::metrics::flip;
 use igi_core::scene::{builtin, load_scene, Scene};
 use igi_core::settings::{Accelerations, RenderSettings};
-use igi_gpu::{AdapterChoice, GpuContext, Renderer};
+use igi_gpu::Renderer;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -193,6 +194,30 @@ fn check_out(opts: &BenchOptions, setups: &[(String, Accelerations)]) -> Result<
     Ok(())
 }
 
+/// A scene as `igi bench` measures it: its argument, the scene, and the reference image
+/// with its path, where there is one.
+type Input<'a> = (&'a String, Scene, Option<PathBuf>, Option<Image>);
+
+/// Every scene and reference read before anything is rendered or created: a bad scene or
+/// reference leaves no empty --out folder.
+fn read_inputs(opts: &BenchOptions) -> Result<Vec<Input<'_>>> {
+    let mut inputs = vec![];
+    for arg in &opts.scenes {
+        let scene = load(arg)?;
+        let reference_path = match &opts.reference {
+            Some(p) => Some(p.clone()),
+            None if !arg.starts_with("builtin:") => find_reference(Path::new(arg)),
+            None => None,
+        };
+        let reference = match &reference_path {
+            Some(p) => Some(Image::read_exr(p)?),
+            None => None,
+        };
+        inputs.push((arg, scene, reference_path, reference));
+    }
+    Ok(inputs)
+}
+
 /// Run the whole benchmark and write its images into `opts.out` (the report is written
 /// by the caller with `report::write_all`).
 pub fn run(opts: &BenchOptions) -> Result<BenchResults> {
@@ -217,26 +242,21 @@ pub fn run(opts: &BenchOptions) -> Result<BenchResults> {
                 .map_err(|e| anyhow::anyhow!("--setups: {e}"))
         })
         .collect::<Result<_>>()?;
-    // Every input is read and every output checked before anything is rendered or
-    // created: a bad scene or reference leaves no empty --out folder, and a report name
-    // taken by a directory no images without their report. The folder itself is made
-    // right before the first image is written.
-    let mut inputs = vec![];
-    for arg in &opts.scenes {
-        let scene = load(arg)?;
-        let reference_path = match &opts.reference {
-            Some(p) => Some(p.clone()),
-            None if !arg.starts_with("builtin:") => find_reference(Path::new(arg)),
-            None => None,
-        };
-        let reference = match &reference_path {
-            Some(p) => Some(Image::read_exr(p)?),
-            None => None,
-        };
-        inputs.push((arg, scene, reference_path, reference));
-    }
+    // The outputs are checked before the scenes are read (which can take seconds): a
+    // report name taken by a directory leaves no images without their report. The folder
+    // itself is made right before the first image is written.
     check_out(opts, &setups)?;
-    let ctx = GpuContext::new(&AdapterChoice::from_option(opts.adapter.as_deref()))?;
+    // The GPU is set up while the inputs are read (GpuSetUp), and its passes are made
+    // once for every scene.
+    let gpu = GpuSetUp::start(opts.adapter.clone())?;
+    let inputs = match read_inputs(opts) {
+        Ok(inputs) => inputs,
+        Err(e) => {
+            gpu.abandon();
+            return Err(e);
+        }
+    };
+    let (ctx, passes) = gpu.join()?;
     if !ctx.timestamps {
         bail!(
             "adapter '{}' has no timestamp queries: igi bench needs them",
@@ -254,12 +274,16 @@ pub fn run(opts: &BenchOptions) -> Result<BenchResults> {
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     let mut runs = vec![];
+    let mut free_passes = Some(passes);
     for (arg, scene, reference_path, reference) in inputs {
         let name = scene_name(arg);
         let t = Instant::now();
         let bvh = Bvh::build_with(&scene.triangles, opts.bvh);
         let bvh_build_ms = t.elapsed().as_secs_f64() * 1e3;
-        let mut renderer = Renderer::new(&ctx, &scene, &bvh)?;
+        let passes = free_passes
+            .take()
+            .expect("the last scene's renderer gave its passes back");
+        let mut renderer = Renderer::with_passes(&ctx, passes, &scene, &bvh)?;
         for (setup, accelerations) in &setups {
             for &vpls in &opts.vpls {
                 bar.set_message(format!("{name} {setup} {vpls} VPLs"));
@@ -381,6 +405,7 @@ pub fn run(opts: &BenchOptions) -> Result<BenchResults> {
                 bar.inc(1);
             }
         }
+        free_passes = Some(renderer.into_passes());
     }
     bar.finish_and_clear();
     Ok(BenchResults {
