@@ -338,13 +338,15 @@ fn skipped_for_no_adapter(out: &Output) -> bool {
 #[test]
 fn bench_runs_tiny_and_its_json_parses() {
     let d = temp_dir("bench");
-    // Two scenes: the second renderer gets the passes of the first.
+    // Three scenes: each renderer gets the passes of the one before; the third has the
+    // first one's name, and is reported (and its files written) under a name of its own.
     let quad_dir = temp_dir("bench-quad");
     let quad = scene_with_obj(&quad_dir, QUAD);
     let out = igi(&[
         "bench",
         "builtin:cornell-box",
         quad.to_str().unwrap(),
+        "builtin:cornell-box",
         "--width",
         "32",
         "--height",
@@ -372,7 +374,15 @@ fn bench_runs_tiny_and_its_json_parses() {
     let text = std::fs::read_to_string(d.join("results.json")).unwrap();
     // Every field present: the typed parse fails on a missing one.
     let results: igi::bench::model::BenchResults = serde_json::from_str(&text).unwrap();
-    assert_eq!(results.runs.len(), 2);
+    assert_eq!(results.runs.len(), 3);
+    let again = &results.runs[2];
+    assert_eq!(
+        (again.scene.as_str(), again.image_exr.as_str()),
+        ("cornell-box-2", "cornell-box-2-iv_ds_il-30.exr")
+    );
+    assert!(d.join(&again.image_exr).exists());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("named cornell-box-2"), "{stderr}");
     let quad_run = &results.runs[1];
     assert_eq!(quad_run.scene_path, quad.to_str().unwrap());
     assert_eq!(quad_run.triangles, 2);

@@ -178,8 +178,7 @@ fn check_out(opts: &BenchOptions, setups: &[(String, Accelerations)]) -> Result<
         .iter()
         .map(|n| n.to_string())
         .collect();
-    for arg in &opts.scenes {
-        let name = scene_name(arg);
+    for name in scene_names(&opts.scenes) {
         names.extend(super::report::chart_files(&name));
         for (setup, _) in setups {
             for &vpls in &opts.vpls {
@@ -216,6 +215,28 @@ fn read_inputs(opts: &BenchOptions) -> Result<Vec<Input<'_>>> {
         inputs.push((arg, scene, reference_path, reference));
     }
     Ok(inputs)
+}
+
+/// The names of the scenes in a report and its files ([`scene_name`]), one per scene: a
+/// name whose file stem ([`super::report::file_stem`]) an earlier scene has taken gets
+/// "-2", "-3", ... (two scenes of one name, such as `builtin:cornell-box` and
+/// `cornell-box/scene.toml`, wrote one set of images and charts, the second over the
+/// first).
+pub fn scene_names(args: &[String]) -> Vec<String> {
+    let stem = super::report::file_stem;
+    let mut names: Vec<String> = vec![];
+    for arg in args {
+        let base = scene_name(arg);
+        let mut name = base.clone();
+        let mut k = 1;
+        // Against every name so far, the renamed ones included ("a-2" may be a name too).
+        while names.iter().any(|n| stem(n) == stem(&name)) {
+            k += 1;
+            name = format!("{base}-{k}");
+        }
+        names.push(name);
+    }
+    names
 }
 
 /// Run the whole benchmark and write its images into `opts.out` (the report is written
@@ -275,8 +296,13 @@ pub fn run(opts: &BenchOptions) -> Result<BenchResults> {
     );
     let mut runs = vec![];
     let mut free_passes = Some(passes);
-    for (arg, scene, reference_path, reference) in inputs {
-        let name = scene_name(arg);
+    let scene_names = scene_names(&opts.scenes);
+    for (arg, name) in opts.scenes.iter().zip(&scene_names) {
+        if *name != scene_name(arg) {
+            eprintln!("note: scene {arg} is named {name} in the report: its name is taken by an earlier scene");
+        }
+    }
+    for ((arg, scene, reference_path, reference), name) in inputs.into_iter().zip(scene_names) {
         let t = Instant::now();
         let bvh = Bvh::build_with(&scene.triangles, opts.bvh);
         let bvh_build_ms = t.elapsed().as_secs_f64() * 1e3;
@@ -424,4 +450,36 @@ pub fn run(opts: &BenchOptions) -> Result<BenchResults> {
         },
         runs,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn scenes_of_one_name_get_names_of_their_own() {
+        let args = [
+            "builtin:cornell-box",
+            "a/cornell-box.toml",
+            "b/room.toml",
+            "room-2.toml",
+            "c/room.toml",
+            "cornell box.toml",
+        ]
+        .map(String::from);
+        assert_eq!(
+            scene_names(&args),
+            [
+                "cornell-box",
+                "cornell-box-2",
+                "room",
+                "room-2",
+                "room-3",
+                // Its file stem, cornell_box, is not another's.
+                "cornell box",
+            ]
+        );
+        let args = ["a/x y.toml", "b/x_y.toml"].map(String::from);
+        assert_eq!(scene_names(&args), ["x y", "x_y-2"]);
+    }
 }
