@@ -223,6 +223,50 @@ pub fn rel_mse(image: &Image, reference: &Image) -> Result<f64, ImageError> {
     Ok(sum / (3 * image.data.len().max(1)) as f64)
 }
 
+/// Where two images of one size differ, pixel by pixel: what `igi compare` reports
+/// beside the relMSE, which rounds small differences to 0 and does not tell a few wrong
+/// pixels from many slightly different ones.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PixelDifferences {
+    /// Pixels with a channel whose bits differ (NaN against NaN counts as equal only in
+    /// the same bits).
+    pub differing: usize,
+    pub pixels: usize,
+    /// The largest |image - reference| of a channel, its pixel (x, y) and the
+    /// reference's value there; `None` where no pixel differs.
+    pub largest: Option<(f32, (u32, u32), f32)>,
+}
+
+/// The [`PixelDifferences`] of `image` against `reference`.
+pub fn pixel_differences(image: &Image, reference: &Image) -> Result<PixelDifferences, ImageError> {
+    same_size(image, reference)?;
+    let mut differing = 0;
+    let mut largest: Option<(f32, (u32, u32), f32)> = None;
+    for (i, (p, r)) in image.data.iter().zip(&reference.data).enumerate() {
+        if p.map(f32::to_bits) == r.map(f32::to_bits) {
+            continue;
+        }
+        differing += 1;
+        for c in 0..3 {
+            let d = (p[c] - r[c]).abs();
+            // A NaN difference (one side NaN or infinite) is the largest there is.
+            let d = if d.is_nan() { f32::INFINITY } else { d };
+            if largest.is_none_or(|(l, _, _)| d > l) {
+                let at = (
+                    (i % image.width as usize) as u32,
+                    (i / image.width as usize) as u32,
+                );
+                largest = Some((d, at, r[c]));
+            }
+        }
+    }
+    Ok(PixelDifferences {
+        differing,
+        pixels: image.data.len(),
+        largest,
+    })
+}
+
 /// The file that writing `path` replaces: `path` with its symbolic links followed (the
 /// link stays and its target gets the new contents, as a shell's `>` does), in a
 /// directory named canonically, so that two names of one file compare equal. Errors,
@@ -368,6 +412,31 @@ pub fn write_atomically(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn pixel_differences_count_pixels_and_find_the_largest() {
+        let mut a = Image::new(4, 3);
+        a.data.fill([0.5, 0.25, 1.0]);
+        let mut b = a.clone();
+        let same = pixel_differences(&a, &b).unwrap();
+        assert_eq!((same.differing, same.pixels, same.largest), (0, 12, None));
+        // Two pixels differ: one by an ulp, one by 0.125 in blue at (1, 2).
+        b.data[5][0] = f32::from_bits(0.5f32.to_bits() + 1);
+        b.data[9][2] = 0.875;
+        let d = pixel_differences(&a, &b).unwrap();
+        assert_eq!(d.differing, 2);
+        assert_eq!(d.largest, Some((0.125, (1, 2), 0.875)));
+        // A NaN pixel is the largest difference; the same NaN on both sides is none.
+        b.data[2][1] = f32::NAN;
+        let d = pixel_differences(&a, &b).unwrap();
+        assert_eq!(
+            (d.differing, d.largest.map(|l| (l.0, l.1))),
+            (3, Some((f32::INFINITY, (2, 0))))
+        );
+        a.data[2][1] = f32::NAN;
+        assert_eq!(pixel_differences(&a, &b).unwrap().differing, 2);
+        assert!(pixel_differences(&a, &Image::new(3, 4)).is_err());
+    }
 
     #[test]
     fn files_of_other_kinds_are_not_openexr() {

@@ -263,6 +263,24 @@ fn renders_builtin_cornell_box_to_png_and_exr() {
         "mean {mean:?}"
     );
     assert!(std::fs::metadata(&png).unwrap().len() > 100);
+    // igi compare: the image against itself, and against a copy with one pixel changed.
+    let same = igi(&["compare", exr.to_str().unwrap(), exr.to_str().unwrap()]);
+    let stdout = String::from_utf8_lossy(&same.stdout);
+    assert!(stdout.contains("relMSE 0.00000\n"), "{stdout}");
+    assert!(
+        stdout.contains("pixels differing: none of 4096"),
+        "{stdout}"
+    );
+    let mut changed = image.clone();
+    changed.data[64 * 10 + 3][1] += 0.5;
+    let other = exr.with_file_name("changed.exr");
+    changed.write_exr(&other).unwrap();
+    let out = igi(&["compare", other.to_str().unwrap(), exr.to_str().unwrap()]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.contains("pixels differing: 1 of 4096; largest difference 5.000e-1 at (3, 10)"),
+        "{stdout}"
+    );
 }
 
 #[test]
