@@ -126,14 +126,22 @@ impl Image {
 
     /// Write float32 RGB OpenEXR (linear radiance, no exposure).
     pub fn write_exr(&self, path: &Path) -> Result<(), ImageError> {
-        use exr::prelude::{SpecificChannels, Vec2, WritableImage};
+        use exr::prelude::{Encoding, LineOrder, SpecificChannels, Vec2, WritableImage};
         write_atomically(path, |file| {
             let channels = SpecificChannels::rgb(|Vec2(x, y): Vec2<usize>| {
                 let p = self.data[y * self.width as usize + x];
                 (p[0], p[1], p[2])
             });
-            exr::prelude::Image::from_channels(
+            // The crate's default (RLE, 64 x 64 tiles) with its tiles in increasing
+            // order: the default's unspecified order writes them as the threads finish
+            // compressing, so one image made files of different bytes from run to run.
+            let encoding = Encoding {
+                line_order: LineOrder::Increasing,
+                ..Encoding::FAST_LOSSLESS
+            };
+            exr::prelude::Image::from_encoded_channels(
                 (self.width as usize, self.height as usize),
+                encoding,
                 channels,
             )
             .write()
@@ -412,6 +420,39 @@ pub fn write_atomically(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// One image makes one file, byte for byte: its tiles in increasing order, whatever
+    /// order the threads compress them in.
+    #[test]
+    fn exr_files_of_one_image_are_the_same_bytes() {
+        let dir = std::env::temp_dir().join(format!("igi-exr-bytes-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        // 20 tiles of 64 x 64, of uneven content so that they compress unevenly.
+        let mut image = Image::new(320, 256);
+        for (i, p) in image.data.iter_mut().enumerate() {
+            let v = if (i / 320) % 64 < 32 {
+                0.5
+            } else {
+                (i as f32 * 0.618).fract()
+            };
+            *p = [v, v * 0.5, 1.0 - v];
+        }
+        let paths = [dir.join("a.exr"), dir.join("b.exr")];
+        for p in &paths {
+            image.write_exr(p).unwrap();
+        }
+        let meta = exr::meta::MetaData::read_from_file(&paths[0], false).unwrap();
+        assert_eq!(
+            meta.headers[0].line_order,
+            exr::meta::attribute::LineOrder::Increasing
+        );
+        assert_eq!(
+            std::fs::read(&paths[0]).unwrap(),
+            std::fs::read(&paths[1]).unwrap()
+        );
+        assert_eq!(Image::read_exr(&paths[0]).unwrap().data, image.data);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 
     #[test]
     fn pixel_differences_count_pixels_and_find_the_largest() {
