@@ -291,6 +291,18 @@ impl GpuContext {
         })
     }
 
+    /// Wait for the work of one submission (and all before it), then report the first
+    /// device error seen, if any.
+    pub fn wait_for(&self, submission: wgpu::SubmissionIndex) -> Result<(), GpuError> {
+        self.device
+            .poll(wgpu::PollType::Wait {
+                submission_index: Some(submission),
+                timeout: None,
+            })
+            .map_err(|e| GpuError::Device(e.to_string()))?;
+        self.check()
+    }
+
     /// Wait for all submitted work, then report the first device error seen, if any.
     pub fn finish(&self) -> Result<(), GpuError> {
         self.device

@@ -130,6 +130,13 @@ impl Passes {
     }
 }
 
+/// Accumulated frames submitted ahead of the one the GPU runs
+/// ([`Renderer::render_with_progress`]): enough that the GPU always has the next. On
+/// lavapipe, whose work runs on the CPU's cores, one ahead took 6.8 s for 300 frames of
+/// 32 x 24 where all at once took 4.9 s; four ahead measured alike with all at once (5.2-
+/// 5.8 s against 5.4-6.3 s, three alternations).
+pub const FRAMES_IN_FLIGHT: usize = 4;
+
 pub struct Renderer {
     scene: SceneBuffers,
     vpl: VplPass,
@@ -181,6 +188,8 @@ pub struct Renderer {
     software: bool,
     /// Whether the next frame counts its rays (see [`Renderer::count_rays`]).
     counting: bool,
+    /// The queue's submission of the last frame (see [`Renderer::render_with_progress`]).
+    last_submission: wgpu::SubmissionIndex,
 }
 
 fn storage(device: &wgpu::Device, label: &str, size: u64) -> wgpu::Buffer {
@@ -279,6 +288,8 @@ impl Renderer {
             ray_offset_floor: igi_core::bvh::offset_floor(lo, hi),
             path_cache: None,
             counting: false,
+            // Nothing of the renderer's is submitted yet: an empty submission's index.
+            last_submission: ctx.queue.submit([]),
             software: ctx.is_software(),
             has_mirrors: scene.materials.iter().any(|m| m.mirror.max_element() > 0.0),
         };
@@ -743,15 +754,43 @@ impl Renderer {
         ctx: &GpuContext,
         settings: &RenderSettings,
     ) -> Result<FrameOutput, GpuError> {
+        self.render_with_progress(ctx, settings, |_| {})
+    }
+
+    /// [`Renderer::render`], calling `progress(k)` once k of the accumulated frames have
+    /// run on the GPU, for k = 1 to their number, in order. At most [`FRAMES_IN_FLIGHT`] frames are submitted ahead: they were
+    /// all submitted at once before, so a long accumulation said nothing until its end
+    /// (3,000 frames on lavapipe: 55 s).
+    pub fn render_with_progress(
+        &mut self,
+        ctx: &GpuContext,
+        settings: &RenderSettings,
+        mut progress: impl FnMut(u32),
+    ) -> Result<FrameOutput, GpuError> {
         Self::check_size(ctx, settings)?;
         let mut names = vec![];
         let mut paths = 0;
-        for k in 0..settings.accumulate.max(1) {
+        let frames = settings.accumulate.max(1);
+        let mut in_flight = std::collections::VecDeque::new();
+        for k in 0..frames {
+            if in_flight.len() == FRAMES_IN_FLIGHT {
+                if let Some(oldest) = in_flight.pop_front() {
+                    // Frame k - FRAMES_IN_FLIGHT and all before it have run.
+                    ctx.wait_for(oldest)?;
+                    progress(k + 1 - FRAMES_IN_FLIGHT as u32);
+                }
+            }
             let frame = RenderSettings {
                 frame: settings.frame + k,
                 ..settings.clone()
             };
             (names, paths) = self.submit_frame(ctx, &frame, k)?;
+            in_flight.push_back(self.last_submission.clone());
+        }
+        let left = in_flight.len() as u32;
+        for (j, submission) in in_flight.into_iter().enumerate() {
+            ctx.wait_for(submission)?;
+            progress(frames - left + 1 + j as u32);
         }
         let image = self.read_image(ctx)?;
         let vpl_count = self.vpl_count(ctx)?;
@@ -857,7 +896,7 @@ impl Renderer {
             });
         let names = self.encode_frame(&ctx.device, &mut encoder, settings, paths);
         self.profiler.resolve(&mut encoder, names.len() as u32);
-        ctx.queue.submit([encoder.finish()]);
+        self.last_submission = ctx.queue.submit([encoder.finish()]);
         Ok((names, paths))
     }
 

@@ -99,6 +99,35 @@ fn moved_light_and_camera_match_a_fresh_renderer() {
     assert!(e.contains("0 lights given") && e.contains("has 1"), "{e}");
 }
 
+/// An accumulation reports each frame as it runs, 1 to N in order (at most
+/// FRAMES_IN_FLIGHT submitted ahead), and gives the image `render` gives, bit for bit.
+#[test]
+fn accumulation_reports_its_frames_in_order() {
+    let Some(ctx) = gpu() else { return };
+    let scene = builtin_scene("cornell-box").expect("built-in");
+    let bvh = Bvh::build(&scene.triangles);
+    let mut renderer = Renderer::new(&ctx, &scene, &bvh).expect("renderer");
+    for frames in [1, 3, igi_gpu::frame::FRAMES_IN_FLIGHT as u32 + 3] {
+        let settings = RenderSettings {
+            width: 24,
+            height: 20,
+            vpls: 12,
+            accumulate: frames,
+            ..RenderSettings::default()
+        };
+        let mut reported = vec![];
+        let with_progress = renderer
+            .render_with_progress(&ctx, &settings, |k| reported.push(k))
+            .expect("frames");
+        assert_eq!(reported, (1..=frames).collect::<Vec<_>>());
+        let plain = renderer.render(&ctx, &settings).expect("frames");
+        assert_eq!(
+            with_progress.image.data, plain.image.data,
+            "{frames} frames"
+        );
+    }
+}
+
 /// The passes of a renderer that drew one scene, handed to a renderer of another scene
 /// (as `igi bench` does with several scenes), give that scene's frame bit for bit as a
 /// renderer with passes of its own does: the passes keep nothing of the first scene.

@@ -748,7 +748,18 @@ fn render(args: &RenderArgs) -> Result<()> {
     );
     eprintln!("adapter: {}", ctx.describe());
     let mut renderer = Renderer::with_passes(&ctx, passes, &scene, &bvh)?;
-    let frame = renderer.render(&ctx, &settings)?;
+    let frame = if settings.accumulate > 1 {
+        // Frames done and the time left, on a terminal (indicatif draws nothing elsewhere).
+        let bar = indicatif::ProgressBar::new(settings.accumulate as u64).with_style(
+            indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} frames, {eta} left")
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+        let frame = renderer.render_with_progress(&ctx, &settings, |k| bar.set_position(k as u64));
+        bar.finish_and_clear();
+        frame?
+    } else {
+        renderer.render(&ctx, &settings)?
+    };
     eprintln!(
         "{}x{}: {} VPLs from {} light paths ({} asked), min_dist {:.4}",
         settings.width,
