@@ -758,9 +758,9 @@ impl Renderer {
     }
 
     /// [`Renderer::render`], calling `progress(k)` once k of the accumulated frames have
-    /// run on the GPU, for k = 1 to their number, in order. At most [`FRAMES_IN_FLIGHT`] frames are submitted ahead: they were
-    /// all submitted at once before, so a long accumulation said nothing until its end
-    /// (3,000 frames on lavapipe: 55 s).
+    /// run on the GPU, for k = 1 to their number, in order. At most [`FRAMES_IN_FLIGHT`]
+    /// frames are submitted ahead: they were all submitted at once before, so a long
+    /// accumulation said nothing until its end (3,000 frames on lavapipe: 55 s).
     pub fn render_with_progress(
         &mut self,
         ctx: &GpuContext,
