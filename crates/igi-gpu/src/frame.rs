@@ -188,8 +188,6 @@ pub struct Renderer {
     software: bool,
     /// Whether the next frame counts its rays (see [`Renderer::count_rays`]).
     counting: bool,
-    /// The queue's submission of the last frame (see [`Renderer::render_with_progress`]).
-    last_submission: wgpu::SubmissionIndex,
 }
 
 fn storage(device: &wgpu::Device, label: &str, size: u64) -> wgpu::Buffer {
@@ -288,8 +286,6 @@ impl Renderer {
             ray_offset_floor: igi_core::bvh::offset_floor(lo, hi),
             path_cache: None,
             counting: false,
-            // Nothing of the renderer's is submitted yet: an empty submission's index.
-            last_submission: ctx.queue.submit([]),
             software: ctx.is_software(),
             has_mirrors: scene.materials.iter().any(|m| m.mirror.max_element() > 0.0),
         };
@@ -770,27 +766,31 @@ impl Renderer {
         Self::check_size(ctx, settings)?;
         let mut names = vec![];
         let mut paths = 0;
-        let frames = settings.accumulate.max(1);
+        // Each wait, for the oldest submission, is one more frame run.
+        let mut done = 0;
+        let mut wait = |submission| {
+            ctx.wait_for(submission).map(|()| {
+                done += 1;
+                progress(done);
+            })
+        };
         let mut in_flight = std::collections::VecDeque::new();
-        for k in 0..frames {
+        for k in 0..settings.accumulate.max(1) {
             if in_flight.len() == FRAMES_IN_FLIGHT {
                 if let Some(oldest) = in_flight.pop_front() {
-                    // Frame k - FRAMES_IN_FLIGHT and all before it have run.
-                    ctx.wait_for(oldest)?;
-                    progress(k + 1 - FRAMES_IN_FLIGHT as u32);
+                    wait(oldest)?;
                 }
             }
             let frame = RenderSettings {
                 frame: settings.frame + k,
                 ..settings.clone()
             };
-            (names, paths) = self.submit_frame(ctx, &frame, k)?;
-            in_flight.push_back(self.last_submission.clone());
+            let submission;
+            (names, paths, submission) = self.submit_frame_indexed(ctx, &frame, k)?;
+            in_flight.push_back(submission);
         }
-        let left = in_flight.len() as u32;
-        for (j, submission) in in_flight.into_iter().enumerate() {
-            ctx.wait_for(submission)?;
-            progress(frames - left + 1 + j as u32);
+        for submission in in_flight {
+            wait(submission)?;
         }
         let image = self.read_image(ctx)?;
         let vpl_count = self.vpl_count(ctx)?;
@@ -846,6 +846,17 @@ impl Renderer {
         settings: &RenderSettings,
         accumulate_index: u32,
     ) -> Result<(Vec<&'static str>, u32), GpuError> {
+        self.submit_frame_indexed(ctx, settings, accumulate_index)
+            .map(|(names, paths, _)| (names, paths))
+    }
+
+    /// [`Renderer::submit_frame`], with the queue's index of the frame's submission.
+    fn submit_frame_indexed(
+        &mut self,
+        ctx: &GpuContext,
+        settings: &RenderSettings,
+        accumulate_index: u32,
+    ) -> Result<(Vec<&'static str>, u32, wgpu::SubmissionIndex), GpuError> {
         Self::check_size(ctx, settings)?;
         check_settings(settings)?;
         let paths = self.path_count(ctx, settings)?;
@@ -896,8 +907,8 @@ impl Renderer {
             });
         let names = self.encode_frame(&ctx.device, &mut encoder, settings, paths);
         self.profiler.resolve(&mut encoder, names.len() as u32);
-        self.last_submission = ctx.queue.submit([encoder.finish()]);
-        Ok((names, paths))
+        let submission = ctx.queue.submit([encoder.finish()]);
+        Ok((names, paths, submission))
     }
 
     /// Empties the direct pass's lists for the frame about to be submitted (its direct
