@@ -103,6 +103,18 @@ pub(super) struct PrimRef {
 }
 
 impl PrimRef {
+    /// The reference of box `lo`..`hi`, with any -0 bound made +0: SSE's min and max
+    /// return their second operand for -0 and +0, so the bins' boxes would depend on the
+    /// order of the primitives binned into them (and so on the number of threads that bin
+    /// the root) only through such signs.
+    #[inline]
+    pub(super) fn new(lo: Vec3A, hi: Vec3A) -> PrimRef {
+        PrimRef {
+            lo: lo + Vec3A::ZERO,
+            hi: hi + Vec3A::ZERO,
+        }
+    }
+
     #[inline]
     pub(super) fn centroid2(&self) -> Vec3A {
         self.lo + self.hi
@@ -615,7 +627,7 @@ where
             // on it); a point box keeps it out of everyone's way and keeps centroids
             // comparable (no NaN), which the sort of SmallSweep relies on.
             let prim = if lo.is_finite() && hi.is_finite() {
-                PrimRef { lo, hi }
+                PrimRef::new(lo, hi)
             } else {
                 PrimRef {
                     lo: Vec3A::ZERO,
@@ -1381,9 +1393,49 @@ type Bins = ([[Aabb; SAH_BINS]; 3], [[u32; SAH_BINS]; 3]);
 /// Empty bins: every box [`Aabb::EMPTY`], every count 0.
 const NO_BINS: Bins = ([[Aabb::EMPTY; SAH_BINS]; 3], [[0; SAH_BINS]; 3]);
 
+/// Ranges of at least this many primitives are binned into two sets of bins, see
+/// [`bin_range`].
+const TWO_BIN_SETS_FROM: usize = 64;
+
 /// Adds the primitives of a range to `bins` (in place: bins returned by value were copied
-/// out, 2 M instructions of a build).
-fn bin_range(prims: &[PrimRef], binner: &Binner, (bins, counts): &mut Bins) {
+/// out, 2 M instructions of a build). Neighbouring primitives of a range are near each
+/// other, so they often fall into the same bin: each one's update then waits for the one
+/// before it to be stored (a chain of load, min/max and store per primitive). A large
+/// range is therefore binned into two sets, even and odd primitives, merged at the end
+/// (docs/PERFORMANCE.md attempt 122). Min, max and sums do not depend on the order of
+/// finite bounds without -0 ([`PrimRef::new`]), so the bins are the same to the bit.
+fn bin_range(prims: &[PrimRef], binner: &Binner, bins: &mut Bins, nb: usize) {
+    if prims.len() < TWO_BIN_SETS_FROM {
+        bin_into(prims.iter(), binner, bins);
+        return;
+    }
+    let mut odd = NO_BINS;
+    let (pairs, rest) = prims.as_chunks::<2>();
+    for [a, b] in pairs {
+        bin_into(std::iter::once(a), binner, bins);
+        bin_into(std::iter::once(b), binner, &mut odd);
+    }
+    bin_into(rest.iter(), binner, bins);
+    merge_bins(bins, &odd, nb);
+}
+
+/// Adds `from`'s first `nb` bins of each axis to `bins`.
+fn merge_bins((bins, counts): &mut Bins, (from, from_counts): &Bins, nb: usize) {
+    for axis in 0..3 {
+        for k in 0..nb {
+            bins[axis][k].grow(&from[axis][k]);
+            counts[axis][k] += from_counts[axis][k];
+        }
+    }
+}
+
+/// The binning loop of [`bin_range`], into one set of bins.
+#[inline(always)]
+fn bin_into<'a>(
+    prims: impl Iterator<Item = &'a PrimRef>,
+    binner: &Binner,
+    (bins, counts): &mut Bins,
+) {
     for p in prims {
         let b = binner.bins(p.centroid2());
         for axis in 0..3 {
@@ -1408,19 +1460,14 @@ fn find_split(prims: &[PrimRef], cbounds: &Aabb, parallel: bool) -> Option<Split
         let binner = &binner;
         rayon_core::scope(|s| {
             for (c, part) in prims.chunks(chunk).zip(&mut parts) {
-                s.spawn(move |_| bin_range(c, binner, part));
+                s.spawn(move |_| bin_range(c, binner, part, nb));
             }
         });
-        for (b, c) in &parts {
-            for axis in 0..3 {
-                for k in 0..nb {
-                    bins.0[axis][k].grow(&b[axis][k]);
-                    bins.1[axis][k] += c[axis][k];
-                }
-            }
+        for part in &parts {
+            merge_bins(&mut bins, part, nb);
         }
     } else {
-        bin_range(prims, &binner, &mut bins);
+        bin_range(prims, &binner, &mut bins, nb);
     }
     let (bins, counts) = (&bins.0, &bins.1);
     // The three axes' sweeps side by side (Sweep3), with the same costs to the bit as one
@@ -1665,7 +1712,7 @@ mod sweep_tests {
         let nb = bin_count(prims.len());
         let binner = Binner::new(cbounds, nb);
         let mut bins = NO_BINS;
-        bin_range(prims, &binner, &mut bins);
+        bin_into(prims.iter(), &binner, &mut bins);
         let (bins, counts) = bins;
         let mut best: Option<(usize, u32, f32)> = None;
         for axis in 0..3 {
@@ -1726,7 +1773,7 @@ mod sweep_tests {
     fn bin_sweep_matches_the_one_axis_sweep() {
         let mut r = Pcg64::seed_from_u64(12);
         for case in 0..3_000 {
-            let n = [13, 40, 255, 256, 700][case % 5];
+            let n = [13, 40, 63, 64, 65, 255, 256, 701][case % 8];
             let grid = [1.0, 3.0, 50.0, 1e4][case % 4];
             let mut prims = random_prims(&mut r, n, grid);
             if case % 7 == 0 {
@@ -1736,11 +1783,40 @@ mod sweep_tests {
                     (p.lo.x, p.hi.x) = (-w, w);
                 }
             }
+            if case % 3 == 1 {
+                // Every other one mirrored in y, made as references are made: bounds of
+                // -0 beside those of 0.
+                for p in prims.iter_mut().step_by(2) {
+                    let (lo, hi) = (
+                        p.lo * Vec3A::new(1.0, -1.0, 1.0),
+                        p.hi * Vec3A::new(1.0, -1.0, 1.0),
+                    );
+                    *p = PrimRef::new(lo.min(hi), lo.max(hi));
+                }
+            }
             let (_, cbounds) = range_bounds(&prims);
             let split = find_split(&prims, &cbounds, false);
-            let got = split.map(|s| (s.axis, s.bin, s.cost.to_bits()));
+            let got = split.as_ref().map(|s| (s.axis, s.bin, s.cost.to_bits()));
             let want = reference_split(&prims, &cbounds).map(|(a, b, c)| (a, b, c.to_bits()));
             assert_eq!(got, want, "case {case}");
+            // The sides' boxes (merged from two sets of bins for 64 primitives and more)
+            // are those of the primitives on each side.
+            if let Some(s) = split {
+                let binner = Binner::new(&cbounds, bin_count(n));
+                let (mut left, mut right) = (Aabb::EMPTY, Aabb::EMPTY);
+                for p in &prims {
+                    let side = if (binner.bins(p.centroid2())[s.axis] as u32) < s.bin {
+                        &mut left
+                    } else {
+                        &mut right
+                    };
+                    side.grow(&Aabb { lo: p.lo, hi: p.hi });
+                }
+                let bits =
+                    |b: &Aabb| [b.lo.to_array(), b.hi.to_array()].map(|v| v.map(f32::to_bits));
+                assert_eq!(bits(&s.left), bits(&left), "case {case}: left box");
+                assert_eq!(bits(&s.right), bits(&right), "case {case}: right box");
+            }
         }
     }
 

@@ -174,7 +174,7 @@ fn references_of(t: [Vec3; 3], b: Aabb, min_waste: f32, out: &mut Vec<PrimRef>) 
     // A triangle with a non-finite vertex has a point box at the origin (see `build`)
     // and is never cut.
     if !(v[0].is_finite() && v[1].is_finite() && v[2].is_finite()) {
-        out.push(PrimRef { lo: b.lo, hi: b.hi });
+        out.push(PrimRef::new(b.lo, b.hi));
         return;
     }
     let pad = v[0].abs().max(v[1].abs()).max(v[2].abs()) * CLIP_PAD;
@@ -196,7 +196,7 @@ fn split_piece(
     out: &mut Vec<PrimRef>,
 ) {
     if depth == 0 || poly.n < 3 || !wastes(&b, poly.area(), min_waste) {
-        out.push(PrimRef { lo: b.lo, hi: b.hi });
+        out.push(PrimRef::new(b.lo, b.hi));
         return;
     }
     let e = b.hi - b.lo;
@@ -212,7 +212,7 @@ fn split_piece(
     if lo_part.n < 3 || hi_part.n < 3 {
         // The piece only touches the plane in rounded arithmetic, but the triangle may
         // still reach past it by less than a rounding error: keep the piece whole.
-        out.push(PrimRef { lo: b.lo, hi: b.hi });
+        out.push(PrimRef::new(b.lo, b.hi));
         return;
     }
     for (part, below) in [(lo_part, true), (hi_part, false)] {
