@@ -3,6 +3,8 @@
 
 use std::sync::{Arc, Mutex};
 
+use crate::shader::ParamsBinding;
+
 /// Errors of the GPU layer, each one line for the user.
 #[derive(Clone, Debug, thiserror::Error)]
 pub enum GpuError {
@@ -43,18 +45,27 @@ fn out_of_memory_message(what: &str, bytes: Option<u64>, hint: &str) -> String {
 pub const SOFTWARE_VPLS_PER_DISPATCH: u32 = 8;
 
 /// The most storage buffers one pipeline of igi binds (the direct pass's; a test counts
-/// them in the shaders). wgpu's GL backend offers fewer on some drivers (llvmpipe: 16).
+/// them in the shaders) where its parameter blocks are uniform buffers (GPUs). wgpu's GL
+/// backend offers fewer on some drivers (llvmpipe: 16).
 pub const STORAGE_BUFFERS_PER_STAGE: u32 = 19;
+
+/// The most storage buffers one pipeline of igi binds with its parameter blocks bound as
+/// `params` (software adapters bind them as storage buffers too).
+pub fn storage_buffers_per_stage(params: ParamsBinding) -> u32 {
+    match params {
+        ParamsBinding::Uniform => STORAGE_BUFFERS_PER_STAGE,
+        // The direct pass's two blocks: the frame's parameters and a VPL range.
+        ParamsBinding::Storage => STORAGE_BUFFERS_PER_STAGE + 2,
+    }
+}
 
 /// Why igi cannot run on `adapter`, or `None` where it can: said when the device is
 /// opened, before a pipeline fails with a multi-line validation dump, and by `igi info`.
 fn shortfall(adapter: &wgpu::Adapter) -> Option<String> {
     let allowed = adapter.limits().max_storage_buffers_per_shader_stage;
-    (allowed < STORAGE_BUFFERS_PER_STAGE).then(|| {
-        format!(
-            "allows {allowed} storage buffers per shader stage; igi needs {STORAGE_BUFFERS_PER_STAGE}"
-        )
-    })
+    let needed = storage_buffers_per_stage(ParamsBinding::for_type(adapter.get_info().device_type));
+    (allowed < needed)
+        .then(|| format!("allows {allowed} storage buffers per shader stage; igi needs {needed}"))
 }
 
 /// Which adapter to use: the best one, or one named by index or by part of its name.

@@ -19,6 +19,7 @@ use crate::passes::{
 };
 use crate::profiler::{Profiler, StageTime};
 use crate::scene_buffers::SceneBuffers;
+use crate::shader::ParamsBinding;
 use igi_core::bvh::Bvh;
 use igi_core::image::Image;
 use igi_core::sampling::{halton_base, pilot_base, DigitPermutations};
@@ -260,13 +261,13 @@ impl Renderer {
             params: device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("frame params"),
                 size: std::mem::size_of::<FrameParams>() as u64,
-                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                usage: ParamsBinding::of(device).usage() | wgpu::BufferUsages::COPY_DST,
                 mapped_at_creation: false,
             }),
             mirror_params: device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("mirror filter params"),
                 size: std::mem::size_of::<FrameParams>() as u64,
-                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                usage: ParamsBinding::of(device).usage() | wgpu::BufferUsages::COPY_DST,
                 mapped_at_creation: false,
             }),
             vpl_header: storage(device, "vpl header", 16),
@@ -566,7 +567,7 @@ impl Renderer {
                 &wgpu::util::BufferInitDescriptor {
                     label: Some("gather ranges"),
                     contents: &bytes,
-                    usage: wgpu::BufferUsages::UNIFORM,
+                    usage: ParamsBinding::of(&ctx.device).usage(),
                 },
             );
             let bind_group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {

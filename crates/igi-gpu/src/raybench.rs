@@ -10,6 +10,7 @@ use crate::layout::FrameParams;
 use crate::passes::{bind, pass_layout, pipeline};
 use crate::profiler::Profiler;
 use crate::scene_buffers::{storage_buffer, SceneBuffers, READ, UNIFORM, WRITE};
+use crate::shader::ParamsBinding;
 use glam::Vec3;
 use igi_core::bvh::Bvh;
 use igi_core::rays::RayRecord;
@@ -141,7 +142,7 @@ impl RayBench {
             &wgpu::util::BufferInitDescriptor {
                 label: Some("rays params"),
                 contents: bytemuck::bytes_of(&FrameParams::default()),
-                usage: wgpu::BufferUsages::UNIFORM,
+                usage: ParamsBinding::of(&ctx.device).usage(),
             },
         );
         let refill = refill_offered(ctx).then(|| {

@@ -44,6 +44,9 @@ pub fn buffer_entry(binding: u32, ty: wgpu::BufferBindingType) -> wgpu::BindGrou
 
 pub const READ: wgpu::BufferBindingType = wgpu::BufferBindingType::Storage { read_only: true };
 pub const WRITE: wgpu::BufferBindingType = wgpu::BufferBindingType::Storage { read_only: false };
+/// A parameter block (a `var<uniform>` of the WGSL) in a list of [`crate::passes::pass_layout`]:
+/// a uniform buffer, or a read-only storage buffer on software adapters
+/// ([`crate::shader::ParamsBinding`]), which `pass_layout` picks for its device.
 pub const UNIFORM: wgpu::BufferBindingType = wgpu::BufferBindingType::Uniform;
 
 /// A storage buffer with `data` (at least 16 bytes: empty arrays still need a binding),

@@ -179,7 +179,7 @@ fn run_upsampler(ctx: &GpuContext, w: u32, h: u32, s: u32, low: &[f32]) -> Vec<[
         &wgpu::util::BufferInitDescriptor {
             label: None,
             contents: bytemuck::bytes_of(&params),
-            usage: wgpu::BufferUsages::UNIFORM,
+            usage: igi_gpu::shader::ParamsBinding::of(&ctx.device).usage(),
         },
     );
     let pos = storage_buffer(ctx, "pos", bytemuck::cast_slice(&positions)).unwrap();

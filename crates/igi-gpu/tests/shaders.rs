@@ -8,6 +8,7 @@ use common::wgsl_constant;
 use igi_gpu::layout::{
     BvhNode, DisplayParams, FrameParams, GpuLight, GpuMaterial, TriShading, Vpl,
 };
+use igi_gpu::shader::{compose_for, ParamsBinding};
 use std::mem::{offset_of, size_of};
 
 fn parse_and_validate(name: &str, src: &str) -> naga::Module {
@@ -36,39 +37,66 @@ fn validate_with(name: &str, src: &str, subgroups: bool) -> naga::Module {
     module
 }
 
+/// Every pass's shader, as GPUs get it (uniform parameter blocks) and as software
+/// adapters do (read-only storage ones).
 #[test]
 fn every_pass_shader_validates() {
     let passes = igi_gpu::passes::SOURCES;
     assert!(passes.len() >= 4);
-    for pass in passes {
-        validate_with(pass.name, &igi_gpu::shader::compose(pass), pass.subgroups);
+    for binding in [ParamsBinding::Uniform, ParamsBinding::Storage] {
+        for pass in passes {
+            let name = format!("{} ({binding:?} params)", pass.name);
+            validate_with(&name, &compose_for(pass, binding), pass.subgroups);
+        }
+    }
+}
+
+/// Software adapters get no uniform buffers at all (lavapipe recompiles shaders whose
+/// branches depend on uniform values every time they are bound, see `ParamsBinding`),
+/// and GPUs get the blocks as uniform buffers still.
+#[test]
+fn software_adapters_get_no_uniform_buffers() {
+    for pass in igi_gpu::passes::SOURCES {
+        let uniforms = |binding| {
+            let module = naga::front::wgsl::parse_str(&compose_for(pass, binding)).unwrap();
+            module
+                .global_variables
+                .iter()
+                .filter(|(_, g)| g.space == naga::AddressSpace::Uniform)
+                .count()
+        };
+        assert_eq!(uniforms(ParamsBinding::Storage), 0, "{}", pass.name);
+        assert!(uniforms(ParamsBinding::Uniform) > 0, "{}", pass.name);
     }
 }
 
 /// The storage buffers of the pass that declares the most, which is what a device must
 /// allow per shader stage: `GpuContext` refuses an adapter with fewer up front, by the
-/// number it is told, so that number must be the shaders' own.
+/// number it is told, so that number must be the shaders' own, for GPUs and for software
+/// adapters (whose parameter blocks are storage buffers too).
 #[test]
 fn storage_buffers_per_stage_is_what_the_shaders_declare() {
-    let most = igi_gpu::passes::SOURCES
-        .iter()
-        .map(|pass| {
-            let module = naga::front::wgsl::parse_str(&igi_gpu::shader::compose(pass)).unwrap();
-            let storage = module
-                .global_variables
-                .iter()
-                .filter(|(_, g)| matches!(g.space, naga::AddressSpace::Storage { .. }))
-                .count() as u32;
-            (storage, pass.name)
-        })
-        .max()
-        .unwrap();
-    assert_eq!(
-        most.0,
-        igi_gpu::context::STORAGE_BUFFERS_PER_STAGE,
-        "the {} pass declares the most storage buffers",
-        most.1
-    );
+    for binding in [ParamsBinding::Uniform, ParamsBinding::Storage] {
+        let most = igi_gpu::passes::SOURCES
+            .iter()
+            .map(|pass| {
+                let module = naga::front::wgsl::parse_str(&compose_for(pass, binding)).unwrap();
+                let storage = module
+                    .global_variables
+                    .iter()
+                    .filter(|(_, g)| matches!(g.space, naga::AddressSpace::Storage { .. }))
+                    .count() as u32;
+                (storage, pass.name)
+            })
+            .max()
+            .unwrap();
+        assert_eq!(
+            most.0,
+            igi_gpu::context::storage_buffers_per_stage(binding),
+            "the {} pass declares the most storage buffers ({binding:?} params)",
+            most.1
+        );
+    }
 }
 
 /// (size, [(member name, offset)]) of the WGSL struct `name`.
@@ -110,7 +138,7 @@ macro_rules! check_layout {
 #[test]
 fn host_structs_match_wgsl() {
     let (name, src) = igi_gpu::shader::all_shaders().remove(0);
-    let module = parse_and_validate(name, &src);
+    let module = parse_and_validate(&name, &src);
     check_layout!(
         &module,
         "BvhNode",
@@ -175,9 +203,9 @@ fn host_structs_match_wgsl() {
 fn display_params_match_wgsl() {
     let (name, src) = igi_gpu::shader::all_shaders()
         .into_iter()
-        .find(|(n, _)| *n == "display")
+        .find(|(n, _)| n == "display")
         .expect("display shader");
-    let module = parse_and_validate(name, &src);
+    let module = parse_and_validate(&name, &src);
     check_layout!(
         &module,
         "DisplayParams",

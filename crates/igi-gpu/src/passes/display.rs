@@ -3,6 +3,7 @@
 //! not a compute stage: `igi render` never runs it. See `shaders/display.wgsl`.
 
 use crate::layout::DisplayParams;
+use crate::shader::ParamsBinding;
 
 /// What the display reads from the renderer (see `Renderer::display_inputs`).
 pub struct DisplayInputs<'a> {
@@ -54,13 +55,14 @@ fn entry(binding: u32, ty: wgpu::BufferBindingType) -> wgpu::BindGroupLayoutEntr
 impl DisplayPass {
     /// Pipelines drawing into targets of `format`.
     pub fn new(device: &wgpu::Device, format: wgpu::TextureFormat) -> DisplayPass {
-        use wgpu::BufferBindingType::{Storage, Uniform};
+        use wgpu::BufferBindingType::Storage;
         let read = Storage { read_only: true };
+        let params = ParamsBinding::of(device);
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("display"),
             entries: &[
-                entry(0, Uniform),
-                entry(1, Uniform),
+                entry(0, params.buffer_type()),
+                entry(1, params.buffer_type()),
                 entry(2, read),
                 entry(3, read),
                 entry(4, read),
@@ -72,7 +74,7 @@ impl DisplayPass {
             .expect("display source");
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("display"),
-            source: wgpu::ShaderSource::Wgsl(crate::shader::compose(source).into()),
+            source: wgpu::ShaderSource::Wgsl(crate::shader::compose_for(source, params).into()),
         });
         // Group 0 (the scene) is declared by the shared modules but unused here.
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -110,7 +112,7 @@ impl DisplayPass {
             params: device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("display params"),
                 size: std::mem::size_of::<DisplayParams>() as u64,
-                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                usage: params.usage() | wgpu::BufferUsages::COPY_DST,
                 mapped_at_creation: false,
             }),
             encode_srgb: !format.is_srgb(),

@@ -10,7 +10,8 @@ pub mod indirect;
 pub mod vpl;
 
 use crate::profiler::Profiler;
-use crate::scene_buffers::buffer_entry;
+use crate::scene_buffers::{buffer_entry, UNIFORM};
+use crate::shader::ParamsBinding;
 
 /// A pass's own WGSL, whether it gathers from VPLs (then it declares `vpls` and
 /// `vpl_header`, and `gather.wgsl` is composed in) and whether it upsamples (then it
@@ -280,10 +281,15 @@ pub(crate) fn pass_layout(
     label: &str,
     types: &[wgpu::BufferBindingType],
 ) -> wgpu::BindGroupLayout {
+    // Parameter blocks (UNIFORM) as this device binds them.
+    let params = ParamsBinding::of(device).buffer_type();
     let entries: Vec<_> = types
         .iter()
         .enumerate()
-        .map(|(i, &ty)| buffer_entry(i as u32, ty))
+        .map(|(i, &ty)| {
+            let ty = if ty == UNIFORM { params } else { ty };
+            buffer_entry(i as u32, ty)
+        })
         .collect();
     device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some(label),
@@ -340,7 +346,9 @@ pub(crate) fn pipeline_with_constants(
     let source = SOURCES.iter().find(|s| s.name == name).expect("known pass");
     let desc = wgpu::ShaderModuleDescriptor {
         label: Some(name),
-        source: wgpu::ShaderSource::Wgsl(crate::shader::compose(source).into()),
+        source: wgpu::ShaderSource::Wgsl(
+            crate::shader::compose_for(source, ParamsBinding::of(device)).into(),
+        ),
     };
     let module = if std::env::var_os("IGI_SHADER_CHECKS").is_some_and(|v| v == "1") {
         device.create_shader_module(desc)
@@ -400,7 +408,7 @@ pub fn gather_range_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
             binding: 0,
             visibility: wgpu::ShaderStages::COMPUTE,
             ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Uniform,
+                ty: ParamsBinding::of(device).buffer_type(),
                 has_dynamic_offset: true,
                 min_binding_size: wgpu::BufferSize::new(16),
             },
