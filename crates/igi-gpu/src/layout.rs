@@ -70,7 +70,8 @@ pub struct Vpl {
     pub _pad1: f32,
 }
 
-/// Parameters of one frame (uniform buffer, 192 bytes).
+/// Parameters of one frame (uniform buffer, 192 bytes; a read-only storage buffer on
+/// software adapters, see `shader::ParamsBinding`).
 /// | offset | field | |
 /// |---|---|---|
 /// | 0 | cam_eye: vec3f | camera position |
@@ -152,7 +153,8 @@ pub struct FrameParams {
     pub _pad: [u32; 2],
 }
 
-/// Parameters of the viewer's display pass (uniform buffer, 48 bytes; `shaders/display.wgsl`).
+/// Parameters of the viewer's display pass (uniform buffer, 48 bytes, storage on software
+/// adapters as [`FrameParams`]; `shaders/display.wgsl`).
 /// | offset | field | |
 /// |---|---|---|
 /// | 0 | viewport: vec4f | the image's rectangle in the target: x, y, width, height (pixels) |

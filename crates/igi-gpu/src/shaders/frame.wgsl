@@ -45,6 +45,9 @@ struct VplHeader {
     _pad: u32,
 }
 
+// A uniform buffer on GPUs; on software adapters `shader::compose_for` makes each
+// uniform declaration a read-only storage buffer (lavapipe recompiled shaders that
+// branch on uniform values at every bind: docs/PERFORMANCE.md attempt 123).
 @group(1) @binding(0) var<uniform> params: FrameParams;
 
 fn uniform_sphere(u1: f32, u2: f32) -> vec3<f32> {
