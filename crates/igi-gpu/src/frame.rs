@@ -247,6 +247,15 @@ impl Renderer {
         // One pass over the triangles for both figures of the scene's size.
         let (lo, hi) = scene.bounds();
         warn_large_min_dist(scene, igi_core::scene::diagonal_of(lo, hi));
+        let params_usage = ParamsBinding::of(device).usage() | wgpu::BufferUsages::COPY_DST;
+        let params_buffer = |label| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: std::mem::size_of::<FrameParams>() as u64,
+                usage: params_usage,
+                mapped_at_creation: false,
+            })
+        };
         let renderer = Renderer {
             vpl,
             direct,
@@ -258,18 +267,8 @@ impl Renderer {
             compose,
             scene: scene_buffers,
             profiler: Profiler::new(ctx, MAX_STAGES),
-            params: device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("frame params"),
-                size: std::mem::size_of::<FrameParams>() as u64,
-                usage: ParamsBinding::of(device).usage() | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            }),
-            mirror_params: device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("mirror filter params"),
-                size: std::mem::size_of::<FrameParams>() as u64,
-                usage: ParamsBinding::of(device).usage() | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            }),
+            params: params_buffer("frame params"),
+            mirror_params: params_buffer("mirror filter params"),
             vpl_header: storage(device, "vpl header", 16),
             no_vpls: (
                 storage(device, "no vpls", std::mem::size_of::<Vpl>() as u64),

@@ -49,6 +49,9 @@ pub enum ParamsBinding {
 const UNIFORM_DECLARATION: &str = "var<uniform>";
 
 impl ParamsBinding {
+    /// Both bindings, GPUs' first: what the shader tests go through.
+    pub const ALL: [ParamsBinding; 2] = [ParamsBinding::Uniform, ParamsBinding::Storage];
+
     /// The binding for `device`.
     pub fn of(device: &wgpu::Device) -> ParamsBinding {
         ParamsBinding::for_type(device.adapter_info().device_type)
@@ -85,10 +88,12 @@ impl ParamsBinding {
 /// (uniform parameter blocks) and as software adapters do (storage ones).
 pub fn all_shaders() -> Vec<(String, String)> {
     let mut shaders = Vec::new();
-    for (binding, suffix) in [
-        (ParamsBinding::Uniform, ""),
-        (ParamsBinding::Storage, " (storage params)"),
-    ] {
+    for binding in ParamsBinding::ALL {
+        // GPUs' shaders keep the passes' own names.
+        let suffix = match binding {
+            ParamsBinding::Uniform => "",
+            ParamsBinding::Storage => " (storage params)",
+        };
         for pass in crate::passes::SOURCES {
             shaders.push((format!("{}{suffix}", pass.name), compose_for(pass, binding)));
         }

@@ -43,7 +43,7 @@ fn validate_with(name: &str, src: &str, subgroups: bool) -> naga::Module {
 fn every_pass_shader_validates() {
     let passes = igi_gpu::passes::SOURCES;
     assert!(passes.len() >= 4);
-    for binding in [ParamsBinding::Uniform, ParamsBinding::Storage] {
+    for binding in ParamsBinding::ALL {
         for pass in passes {
             let name = format!("{} ({binding:?} params)", pass.name);
             validate_with(&name, &compose_for(pass, binding), pass.subgroups);
@@ -76,7 +76,7 @@ fn software_adapters_get_no_uniform_buffers() {
 /// adapters (whose parameter blocks are storage buffers too).
 #[test]
 fn storage_buffers_per_stage_is_what_the_shaders_declare() {
-    for binding in [ParamsBinding::Uniform, ParamsBinding::Storage] {
+    for binding in ParamsBinding::ALL {
         let most = igi_gpu::passes::SOURCES
             .iter()
             .map(|pass| {
