@@ -280,21 +280,21 @@ impl Bvh {
     pub fn build_with(triangles: &[Triangle], builder: BvhBuilder) -> Bvh {
         match builder {
             BvhBuilder::Binned => build::build(triangles),
-            BvhBuilder::Split => build::build_split(triangles.len(), |i| triangles[i].v, MAX_DEPTH),
+            BvhBuilder::Split => build::build_split(triangles, MAX_DEPTH),
         }
     }
 
     /// Same as [`Bvh::build_with`], from bare vertex triples.
     pub fn build_from_vertices_with(triangles: &[[Vec3; 3]], builder: BvhBuilder) -> Bvh {
         match builder {
-            BvhBuilder::Binned => build::build_from_vertices(triangles),
-            BvhBuilder::Split => build::build_split(triangles.len(), |i| triangles[i], MAX_DEPTH),
+            BvhBuilder::Binned => build::build(triangles),
+            BvhBuilder::Split => build::build_split(triangles, MAX_DEPTH),
         }
     }
 
     /// Same as [`Bvh::build`], from bare vertex triples.
     pub fn build_from_vertices(triangles: &[[Vec3; 3]]) -> Bvh {
-        build::build_from_vertices(triangles)
+        build::build(triangles)
     }
 
     /// Number of BVH slots: the triangles, and their repeats with [`BvhBuilder::Split`].

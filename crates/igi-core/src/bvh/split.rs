@@ -24,7 +24,7 @@
 
 use glam::{Vec3, Vec3A};
 
-use super::build::{par_chunks, Aabb, PrimRef};
+use super::build::{par_chunks, Aabb, PrimRef, Triangles};
 #[cfg(doc)]
 use super::{Bvh, BvhBuilder};
 
@@ -115,16 +115,13 @@ impl Poly {
 /// `prims` and `ids`.
 /// Returns the new box of the doubled centroids. The same on any number of threads:
 /// the appended pieces come in triangle order.
-pub(super) fn split_references<F>(
+pub(super) fn split_references<T: Triangles + ?Sized>(
     prims: &mut Vec<PrimRef>,
     ids: &mut Vec<u32>,
     areas: &[f32],
     bounds: &Aabb,
-    tri: &F,
-) -> Aabb
-where
-    F: Fn(usize) -> [Vec3; 3] + Sync,
-{
+    tri: &T,
+) -> Aabb {
     let min_waste = SPLIT_MIN_WASTE * bounds.half_area();
     let parts = par_chunks(prims, |start, chunk| {
         let (mut more, mut more_ids) = (vec![], vec![]);
@@ -138,7 +135,7 @@ where
             let i = start + k;
             if wastes(&b, areas[i], min_waste) {
                 pieces.clear();
-                references_of(tri(i), b, min_waste, &mut pieces);
+                references_of(tri.vertices(i), b, min_waste, &mut pieces);
                 *p = pieces[0];
                 more.extend_from_slice(&pieces[1..]);
                 more_ids.extend(std::iter::repeat_n(i as u32, pieces.len() - 1));

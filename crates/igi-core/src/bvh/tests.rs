@@ -908,10 +908,9 @@ fn split_pieces_cover_their_triangle() {
 }
 
 fn check_pieces(tris: &[[Vec3; 3]], r: &mut Pcg64) {
-    let tri = |i: usize| tris[i];
-    let (mut prims, bounds, _, areas) = super::build::whole_references(tris.len(), &tri, 0);
+    let (mut prims, bounds, _, areas) = super::build::whole_references(tris, 0);
     let mut ids: Vec<u32> = (0..tris.len() as u32).collect();
-    super::split::split_references(&mut prims, &mut ids, &areas, &bounds, &tri);
+    super::split::split_references(&mut prims, &mut ids, &areas, &bounds, tris);
     assert_eq!(prims.len(), ids.len());
     assert!(prims.len() > tris.len(), "nothing was split");
     let mut pieces = vec![vec![]; tris.len()];
