@@ -10,7 +10,7 @@ use igi_core::settings::{
     Accelerations, FilterMode, GeometryBound, InterleavePattern, OutputBuffer, RenderSettings,
     MAX_MIRROR_DEPTH,
 };
-use igi_gpu::{AdapterChoice, GpuContext, Renderer};
+use igi_gpu::{AdapterChoice, Renderer};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
@@ -879,13 +879,33 @@ fn bench_rays(args: &RaysArgs) -> Result<()> {
     // Before the scene is loaded and the rays are made, which can take long: a name that
     // cannot be written is an error now, and one of the scene's files once it is known.
     igi::outputs::check(save.as_slice(), &[])?;
-    let scene = igi::bench::run::load(&args.scene)?;
-    igi::outputs::check(save.as_slice(), &scene.files)?;
-    let t = Instant::now();
-    let builder = args.bvh.builder.into();
-    let bvh = Bvh::build_with(&scene.triangles, builder);
-    let bvh_ms = t.elapsed().as_secs_f64() * 1e3;
-    let ctx = GpuContext::new(&AdapterChoice::from_option(args.adapter.as_deref()))?;
+    // The GPU is set up while the scene loads, as for `igi render`; with the frame's
+    // passes only where a frame makes the rays.
+    let frame_rays = args.set == RaySetArg::Frame && args.load.is_none();
+    let gpu = if frame_rays {
+        igi::gpu_set_up::GpuSetUp::start(args.adapter.clone())?
+    } else {
+        igi::gpu_set_up::GpuSetUp::start_context(args.adapter.clone())?
+    };
+    let loaded = igi::bench::run::load(&args.scene).and_then(|scene| {
+        igi::outputs::check(save.as_slice(), &scene.files)?;
+        Ok(scene)
+    });
+    let scene = match loaded {
+        Ok(scene) => scene,
+        Err(e) => {
+            gpu.abandon();
+            return Err(e);
+        }
+    };
+    // Before the build, which takes every core: an adapter that cannot run the benchmark
+    // is said before it.
+    let (ctx, mut passes) = if frame_rays {
+        let (ctx, passes) = gpu.join()?;
+        (ctx, Some(passes))
+    } else {
+        (gpu.join_context()?, None)
+    };
     if !ctx.timestamps {
         bail!(
             "adapter '{}' has no timestamp queries: igi bench rays needs them",
@@ -898,6 +918,10 @@ fn bench_rays(args: &RaysArgs) -> Result<()> {
             ctx.info.name
         );
     }
+    let t = Instant::now();
+    let builder = args.bvh.builder.into();
+    let bvh = Bvh::build_with(&scene.triangles, builder);
+    let bvh_ms = t.elapsed().as_secs_f64() * 1e3;
     eprintln!(
         "scene {}: {} triangles, {}; adapter: {}",
         scene.source,
@@ -928,7 +952,10 @@ fn bench_rays(args: &RaysArgs) -> Result<()> {
                     seed: args.seed,
                     ..RenderSettings::for_scene(&scene)
                 };
-                let mut renderer = Renderer::new(&ctx, &scene, &bvh)?;
+                let mut renderer = match passes.take() {
+                    Some(passes) => Renderer::with_passes(&ctx, passes, &scene, &bvh)?,
+                    None => Renderer::new(&ctx, &scene, &bvh)?,
+                };
                 renderer.frame_shadow_rays(&ctx, &settings, args.count)?
             }
         };
