@@ -6,8 +6,47 @@
 //! next: docs/PERFORMANCE.md attempt 73).
 
 use std::cell::Cell;
+use std::time::Instant;
 
 use crate::context::{GpuContext, GpuError};
+
+/// Least wall time of untimed work before timed GPU work: an idle GPU clocks down within
+/// a second, and a few short warm-up runs (3 frames, or 3 traces of 10 ms) do not bring
+/// its clocks back up. Medians of `igi bench` doubled without it (docs/PERFORMANCE.md
+/// attempt 4), and a trace of the frame's shadow rays after OptiX had run took 29.7 ms
+/// in 7 of its 10 runs instead of 9.5 ms (attempt 126).
+pub const WARMUP_SECONDS: f64 = 0.5;
+
+/// The untimed runs before timed ones: at least `runs` of them, and while there are any,
+/// at least [`WARMUP_SECONDS`] of them. `while warm_up.more() { run() }`.
+pub struct WarmUp {
+    runs: u32,
+    done: u32,
+    start: Instant,
+}
+
+impl WarmUp {
+    /// A warm-up of at least `runs` runs (none at all for 0), started now.
+    pub fn new(runs: u32) -> WarmUp {
+        WarmUp {
+            runs,
+            done: 0,
+            start: Instant::now(),
+        }
+    }
+
+    /// Whether to make one more untimed run (counted as made).
+    pub fn more(&mut self) -> bool {
+        let more = self.more_after(self.start.elapsed().as_secs_f64());
+        self.done += u32::from(more);
+        more
+    }
+
+    /// Whether a run is still due after `seconds` of warm-up with `done` runs made.
+    fn more_after(&self, seconds: f64) -> bool {
+        self.done < self.runs || (self.runs > 0 && seconds < WARMUP_SECONDS)
+    }
+}
 
 /// GPU time of one stage of a frame.
 #[derive(Clone, Debug, PartialEq)]
@@ -159,5 +198,33 @@ impl Profiler {
             inside_passes: true,
             chained: Cell::new(false),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn warm_up_runs_the_runs_asked_and_for_at_least_its_time() {
+        let at = |runs: u32, done: u32, seconds: f64| {
+            WarmUp {
+                runs,
+                done,
+                start: Instant::now(),
+            }
+            .more_after(seconds)
+        };
+        // No warm-up asked: none, however early.
+        assert!(!at(0, 0, 0.0));
+        // The runs asked, however late.
+        assert!(at(3, 0, 10.0) && at(3, 2, 10.0));
+        // Past them, runs until WARMUP_SECONDS and not after.
+        assert!(at(3, 3, 0.0) && at(3, 50, WARMUP_SECONDS - 0.01));
+        assert!(!at(3, 3, WARMUP_SECONDS) && !at(3, 50, 1.0));
+        // `more` counts what it allows: a warm-up of 1 run says yes at least once.
+        let mut w = WarmUp::new(1);
+        assert!(w.more());
+        assert_eq!(w.done, 1);
     }
 }

@@ -8,7 +8,7 @@
 use crate::context::{GpuContext, GpuError};
 use crate::layout::FrameParams;
 use crate::passes::{bind, pass_layout, pipeline};
-use crate::profiler::Profiler;
+use crate::profiler::{Profiler, WarmUp};
 use crate::scene_buffers::{storage_buffer, SceneBuffers, READ, UNIFORM, WRITE};
 use crate::shader::ParamsBinding;
 use glam::Vec3;
@@ -16,7 +16,8 @@ use igi_core::bvh::Bvh;
 use igi_core::rays::RayRecord;
 use igi_core::scene::Scene;
 
-/// Untimed runs before the timed ones.
+/// Untimed runs before the timed ones, the least: they go on for at least
+/// [`WARMUP_SECONDS`](crate::profiler::WARMUP_SECONDS).
 pub const WARMUP_RUNS: u32 = 3;
 
 /// Threads per workgroup of the ray kernels (`RAY_GROUP` in rays.wgsl).
@@ -173,8 +174,9 @@ impl RayBench {
         self.refill_groups = groups.max(1);
     }
 
-    /// Trace `rays` [`WARMUP_RUNS`] times untimed (the GPU's clocks rise meanwhile), then
-    /// `runs` times timed; results of the last run (every run's results are cleared first,
+    /// Trace `rays` untimed ([`WARMUP_RUNS`] times, and for at least
+    /// [`WARMUP_SECONDS`](crate::profiler::WARMUP_SECONDS): the GPU's clocks rise
+    /// meanwhile), then `runs` times timed; results of the last run (every run's results are cleared first,
     /// so that a ray a run leaves untraced cannot keep an earlier run's answer). `schedule`
     /// applies to any hit (closest hits always run one ray per thread);
     /// [`RaySchedule::Refill`] only where [`refill_offered`].
@@ -237,7 +239,14 @@ impl RayBench {
         };
         let profiler = Profiler::new(ctx, 1);
         let mut runs_ms = vec![];
-        for run in 0..WARMUP_RUNS + runs {
+        let mut warm_up = WarmUp::new(WARMUP_RUNS);
+        let mut timed = 0;
+        loop {
+            // Once the warm-up says no more, it never says more again.
+            let warm = !warm_up.more();
+            if warm && timed == runs {
+                break;
+            }
             let mut encoder = ctx.device.create_command_encoder(&Default::default());
             for counter in &counters {
                 encoder.clear_buffer(counter, 0, None);
@@ -264,10 +273,10 @@ impl RayBench {
             }
             profiler.resolve(&mut encoder, 1);
             ctx.queue.submit([encoder.finish()]);
-            if let Some((_, ms)) = profiler.read(ctx, &["rays"])? {
-                if run >= WARMUP_RUNS {
-                    runs_ms.push(ms);
-                }
+            let ms = profiler.read(ctx, &["rays"])?;
+            if warm {
+                timed += 1;
+                runs_ms.extend(ms.map(|(_, ms)| ms));
             }
         }
         let mut results = vec![];

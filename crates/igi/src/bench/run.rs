@@ -10,14 +10,12 @@ use igi_core::image::{rel_mse, Image};
 use igi_core::metrics::flip;
 use igi_core::scene::{builtin, load_scene, Scene};
 use igi_core::settings::{Accelerations, RenderSettings};
+use igi_gpu::profiler::WarmUp;
 use igi_gpu::Renderer;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
-
-/// Least wall time of warm-up frames before each combination's timed frames.
-pub const WARMUP_SECONDS: f64 = 0.5;
 
 /// What to measure.
 #[derive(Clone, Debug)]
@@ -321,17 +319,13 @@ pub fn run(opts: &BenchOptions) -> Result<BenchResults> {
                     accelerations: accelerations.clone(),
                     ..RenderSettings::for_scene(&scene)
                 };
-                // Warm-up: the frames asked for, and at least WARMUP_SECONDS of frames, so
+                // Warm-up: the frames asked for, and at least `WARMUP_SECONDS` of frames, so
                 // that the GPU's clocks are up again after the CPU work between
                 // combinations (writing images, FLIP).
-                let warm = Instant::now();
-                let mut warmed = 0;
-                while warmed < opts.warmup
-                    || (opts.warmup > 0 && warm.elapsed().as_secs_f64() < WARMUP_SECONDS)
-                {
+                let mut warm_up = WarmUp::new(opts.warmup);
+                while warm_up.more() {
                     renderer.submit_frame(&ctx, &settings, 0)?;
                     ctx.finish()?;
-                    warmed += 1;
                 }
                 let mut frame_ms = vec![];
                 let mut stage_ms: BTreeMap<usize, (&'static str, Vec<f64>)> = BTreeMap::new();
