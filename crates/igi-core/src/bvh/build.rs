@@ -219,47 +219,23 @@ impl Binner {
     }
 }
 
-/// The triangles a build reads: the vertices of triangle `i`, and a hint to fetch them
-/// ahead of a read in scattered order.
-pub(super) trait Triangles: Sync {
-    fn len(&self) -> usize;
-    fn vertices(&self, i: usize) -> [Vec3; 3];
-    /// Asks the cache for triangle `i`'s vertices, where the target can: the rows' pass
-    /// reads the triangles in the tree's order, scattered over the scene's array, and
-    /// these reads taken 32 triangles ahead halved its time on the conference room
-    /// (docs/PERFORMANCE.md attempt 124). Does nothing for an `i` out of range.
-    fn prefetch(&self, i: usize);
+/// A triangle as the build reads it: its three vertices, in place (so that the rows'
+/// pass can prefetch them, see [`triangle_rows`]).
+pub(super) trait Vertices: Sync {
+    fn vertices(&self) -> &[Vec3; 3];
 }
 
-impl Triangles for [Triangle] {
-    fn len(&self) -> usize {
-        self.len()
-    }
+impl Vertices for Triangle {
     #[inline]
-    fn vertices(&self, i: usize) -> [Vec3; 3] {
-        self[i].v
-    }
-    #[inline]
-    fn prefetch(&self, i: usize) {
-        if let Some(t) = self.get(i) {
-            prefetch(&t.v);
-        }
+    fn vertices(&self) -> &[Vec3; 3] {
+        &self.v
     }
 }
 
-impl Triangles for [[Vec3; 3]] {
-    fn len(&self) -> usize {
-        self.len()
-    }
+impl Vertices for [Vec3; 3] {
     #[inline]
-    fn vertices(&self, i: usize) -> [Vec3; 3] {
-        self[i]
-    }
-    #[inline]
-    fn prefetch(&self, i: usize) {
-        if let Some(v) = self.get(i) {
-            prefetch(v);
-        }
+    fn vertices(&self) -> &[Vec3; 3] {
+        self
     }
 }
 
@@ -284,12 +260,12 @@ fn prefetch<T>(value: &T) {
     let _ = value;
 }
 
-pub(super) fn build<T: Triangles + ?Sized>(triangles: &T) -> Bvh {
+pub(super) fn build<T: Vertices>(triangles: &[T]) -> Bvh {
     build_impl(triangles, Limits::new(MAX_DEPTH, ROTATION_BUDGET))
 }
 
 /// With early split clipping of the references (`split`): [`super::BvhBuilder::Split`].
-pub(super) fn build_split<T: Triangles + ?Sized>(triangles: &T, max_depth: u32) -> Bvh {
+pub(super) fn build_split<T: Vertices>(triangles: &[T], max_depth: u32) -> Bvh {
     let limits = Limits {
         split: true,
         ..Limits::new(max_depth, ROTATION_BUDGET)
@@ -437,11 +413,7 @@ pub(super) fn places_as_rows(places: Box<Places<BvhNode>>) -> Vec<TriRow> {
 /// Writes the three rows of each slot (see [`Bvh::tri_rows`]) of the triangles `ids`
 /// into `rows` (empty; grown where it is too small), on all threads (`ids` is only read;
 /// it is split alike by `par_chunks_zip`, which takes two mutable slices).
-fn triangle_rows<T: Triangles + ?Sized>(
-    mut rows: Vec<TriRow>,
-    tri: &T,
-    ids: &mut [u32],
-) -> Vec<TriRow> {
+fn triangle_rows<T: Vertices>(mut rows: Vec<TriRow>, tri: &[T], ids: &mut [u32]) -> Vec<TriRow> {
     let refs = ids.len();
     if rows.capacity() < 3 * refs {
         rows = Vec::with_capacity(3 * refs);
@@ -454,11 +426,16 @@ fn triangle_rows<T: Triangles + ?Sized>(
     };
     par_chunks_zip(slots, ids, |_, slots, ids| {
         for (k, (slot, &id)) in slots.iter_mut().zip(ids.iter()).enumerate() {
-            // 16-32 ahead measured alike, 8 and 64 less well (attempt 124).
-            if let Some(&ahead) = ids.get(k + ROWS_PREFETCH_AHEAD) {
-                tri.prefetch(ahead as usize);
+            // The triangles are read in the tree's order, scattered over the scene's
+            // array: each read waited on the cache until they were asked for ahead,
+            // which halved this pass on the conference room (attempt 124).
+            if let Some(t) = ids
+                .get(k + ROWS_PREFETCH_AHEAD)
+                .and_then(|&a| tri.get(a as usize))
+            {
+                prefetch(t.vertices());
             }
-            let [v0, v1, v2] = tri.vertices(id as usize);
+            let [v0, v1, v2] = *tri[id as usize].vertices();
             slot.write([0, 1, 2].map(|axis| TriRow([v0[axis], v1[axis], v2[axis], 0.0])));
         }
     });
@@ -469,7 +446,8 @@ fn triangle_rows<T: Triangles + ?Sized>(
     rows
 }
 
-/// How many slots ahead [`triangle_rows`] prefetches the triangles it will read.
+/// How many slots ahead [`triangle_rows`] prefetches the triangles it will read: 16 and
+/// 32 measured alike, 8 and 64 less well (docs/PERFORMANCE.md attempt 124).
 const ROWS_PREFETCH_AHEAD: usize = 24;
 
 /// The chunk length of [`par_chunks`] for `n` items, or None where one thread does it all.
@@ -504,7 +482,7 @@ impl Tally {
     }
 }
 
-fn build_impl<T: Triangles + ?Sized>(tri: &T, limits: Limits) -> Bvh {
+fn build_impl<T: Vertices>(tri: &[T], limits: Limits) -> Bvh {
     let count = tri.len();
     let start = Instant::now();
     let mut phases = Phases::new(start);
@@ -657,8 +635,8 @@ impl Phases {
 /// One reference per triangle, its box: (boxes, box of all, box of the doubled centroids,
 /// area of each triangle), the boxes' vector with room for `spare` more. A triangle
 /// with a non-finite vertex has area 0 (see [`occluder_first`]).
-pub(super) fn whole_references<T: Triangles + ?Sized>(
-    tri: &T,
+pub(super) fn whole_references<T: Vertices>(
+    tri: &[T],
     spare: usize,
 ) -> (Vec<PrimRef>, Aabb, Aabb, Vec<f32>) {
     let count = tri.len();
@@ -666,7 +644,7 @@ pub(super) fn whole_references<T: Triangles + ?Sized>(
         count,
         spare,
         |i| {
-            let [a, b, c] = tri.vertices(i).map(Vec3A::from);
+            let [a, b, c] = tri[i].vertices().map(Vec3A::from);
             let (lo, hi) = (a.min(b).min(c), a.max(b).max(c));
             // A triangle with a non-finite vertex is never hit (the triangle test fails
             // on it); a point box keeps it out of everyone's way and keeps centroids

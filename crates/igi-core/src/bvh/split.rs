@@ -24,7 +24,7 @@
 
 use glam::{Vec3, Vec3A};
 
-use super::build::{par_chunks, Aabb, PrimRef, Triangles};
+use super::build::{par_chunks, Aabb, PrimRef, Vertices};
 #[cfg(doc)]
 use super::{Bvh, BvhBuilder};
 
@@ -115,12 +115,12 @@ impl Poly {
 /// `prims` and `ids`.
 /// Returns the new box of the doubled centroids. The same on any number of threads:
 /// the appended pieces come in triangle order.
-pub(super) fn split_references<T: Triangles + ?Sized>(
+pub(super) fn split_references<T: Vertices>(
     prims: &mut Vec<PrimRef>,
     ids: &mut Vec<u32>,
     areas: &[f32],
     bounds: &Aabb,
-    tri: &T,
+    tri: &[T],
 ) -> Aabb {
     let min_waste = SPLIT_MIN_WASTE * bounds.half_area();
     let parts = par_chunks(prims, |start, chunk| {
@@ -135,7 +135,7 @@ pub(super) fn split_references<T: Triangles + ?Sized>(
             let i = start + k;
             if wastes(&b, areas[i], min_waste) {
                 pieces.clear();
-                references_of(tri.vertices(i), b, min_waste, &mut pieces);
+                references_of(*tri[i].vertices(), b, min_waste, &mut pieces);
                 *p = pieces[0];
                 more.extend_from_slice(&pieces[1..]);
                 more_ids.extend(std::iter::repeat_n(i as u32, pieces.len() - 1));
