@@ -117,7 +117,8 @@ struct RaysArgs {
         conflicts_with_all = ["count", "set", "vpls", "width", "height", "seed"]
     )]
     load: Option<PathBuf>,
-    /// Timed runs after one warm-up; the median is reported.
+    /// Timed runs after a warm-up (at least 3 untimed runs and 0.5 s of them, so that the
+    /// GPU's clocks are up); the median is reported.
     #[arg(long, default_value_t = 10)]
     runs: u32,
     /// How the any-hit query hands rays to GPU threads (closest hits: one per thread).
