@@ -13,8 +13,8 @@ use crate::context::{GpuContext, GpuError};
 /// Least wall time of untimed work before timed GPU work: an idle GPU clocks down within
 /// a second, and a few short warm-up runs (3 frames, or 3 traces of 10 ms) do not bring
 /// its clocks back up. Medians of `igi bench` doubled without it (docs/PERFORMANCE.md
-/// attempt 4), and a trace of the frame's shadow rays after OptiX had run took 29.7 ms
-/// in 7 of its 10 runs instead of 9.5 ms (attempt 126).
+/// attempt 4), and a trace of the frame's shadow rays right after OptiX had run took a
+/// median of 29.7 ms over its 10 runs instead of 9.5 ms (attempt 126).
 pub const WARMUP_SECONDS: f64 = 0.5;
 
 /// The untimed runs before timed ones: at least `runs` of them, and while there are any,

@@ -176,8 +176,9 @@ impl RayBench {
 
     /// Trace `rays` untimed ([`WARMUP_RUNS`] times, and for at least
     /// [`WARMUP_SECONDS`](crate::profiler::WARMUP_SECONDS): the GPU's clocks rise
-    /// meanwhile), then `runs` times timed; results of the last run (every run's results are cleared first,
-    /// so that a ray a run leaves untraced cannot keep an earlier run's answer). `schedule`
+    /// meanwhile), then `runs` times timed; results of the last run (every run's results
+    /// are cleared first, so that a ray a run leaves untraced cannot keep an earlier
+    /// run's answer). `schedule`
     /// applies to any hit (closest hits always run one ray per thread);
     /// [`RaySchedule::Refill`] only where [`refill_offered`].
     pub fn trace(
