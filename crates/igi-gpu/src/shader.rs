@@ -84,19 +84,12 @@ impl ParamsBinding {
     }
 }
 
-/// Every composed shader igi builds, by name, for validation tests: as GPUs get them
-/// (uniform parameter blocks) and as software adapters do (storage ones).
-pub fn all_shaders() -> Vec<(String, String)> {
-    let mut shaders = Vec::new();
-    for binding in ParamsBinding::ALL {
-        // GPUs' shaders keep the passes' own names.
-        let suffix = match binding {
-            ParamsBinding::Uniform => "",
-            ParamsBinding::Storage => " (storage params)",
-        };
-        for pass in crate::passes::SOURCES {
-            shaders.push((format!("{}{suffix}", pass.name), compose_for(pass, binding)));
-        }
-    }
-    shaders
+/// Every composed shader igi builds, by name, as GPUs get them (uniform parameter
+/// blocks), for the layout and constant tests; `every_pass_shader_validates` goes through
+/// both bindings itself.
+pub fn all_shaders() -> Vec<(&'static str, String)> {
+    crate::passes::SOURCES
+        .iter()
+        .map(|pass| (pass.name, compose(pass)))
+        .collect()
 }

@@ -138,7 +138,7 @@ macro_rules! check_layout {
 #[test]
 fn host_structs_match_wgsl() {
     let (name, src) = igi_gpu::shader::all_shaders().remove(0);
-    let module = parse_and_validate(&name, &src);
+    let module = parse_and_validate(name, &src);
     check_layout!(
         &module,
         "BvhNode",
@@ -203,9 +203,9 @@ fn host_structs_match_wgsl() {
 fn display_params_match_wgsl() {
     let (name, src) = igi_gpu::shader::all_shaders()
         .into_iter()
-        .find(|(n, _)| n == "display")
+        .find(|(n, _)| *n == "display")
         .expect("display shader");
-    let module = parse_and_validate(&name, &src);
+    let module = parse_and_validate(name, &src);
     check_layout!(
         &module,
         "DisplayParams",
