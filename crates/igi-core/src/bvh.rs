@@ -17,6 +17,7 @@
 //! change there (the GPU test `crates/igi-gpu/tests/traverse_gpu.rs` compares them).
 
 mod build;
+mod huge_pages;
 mod split;
 mod traverse;
 
