@@ -52,7 +52,7 @@ pub struct FrameOutput {
     pub frame_ms: Option<f64>,
 }
 
-/// How many buffers [`ImageBuffers`] holds, each 16 bytes per pixel.
+/// How many buffers the frame's image buffers (`ImageBuffers`) hold, each 16 bytes per pixel.
 pub const IMAGE_BUFFERS: u32 = 15;
 
 /// Buffers sized by the image.

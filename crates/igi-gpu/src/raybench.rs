@@ -168,7 +168,7 @@ impl RayBench {
         })
     }
 
-    /// At most `groups` (>= 1) workgroups per refill dispatch instead of [`REFILL_GROUPS`]:
+    /// At most `groups` (>= 1) workgroups per refill dispatch instead of `REFILL_GROUPS`:
     /// with few of them each lane takes many rays, as on a full GPU (the tests use it).
     pub fn set_refill_groups(&mut self, groups: u32) {
         self.refill_groups = groups.max(1);

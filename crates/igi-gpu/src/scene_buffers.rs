@@ -10,9 +10,9 @@ pub struct SceneBuffers {
     pub layout: wgpu::BindGroupLayout,
     pub bind_group: wgpu::BindGroup,
     /// The same scene with spare ray counters, one set per pass that runs beside another
-    /// one in a frame that counts nothing ([0]: the direct pass beside VPL shooting, [1]
-    /// and [2]: the mirror gather and the indirect gather beside the mirror chains' walks,
-    /// [3]: the mirror discontinuity buffer beside the indirect term's filter): wgpu puts
+    /// one in a frame that counts nothing (`[0]`: the direct pass beside VPL shooting, `[1]`
+    /// and `[2]`: the mirror gather and the indirect gather beside the mirror chains' walks,
+    /// `[3]`: the mirror discontinuity buffer beside the indirect term's filter): wgpu puts
     /// a barrier before a dispatch that binds read-write a buffer an earlier dispatch of
     /// the frame bound read-write, even when neither writes it (`Recorder::side_by_side`).
     pub beside_bind_groups: [wgpu::BindGroup; SPARE_COUNTERS],
@@ -44,7 +44,7 @@ pub fn buffer_entry(binding: u32, ty: wgpu::BufferBindingType) -> wgpu::BindGrou
 
 pub const READ: wgpu::BufferBindingType = wgpu::BufferBindingType::Storage { read_only: true };
 pub const WRITE: wgpu::BufferBindingType = wgpu::BufferBindingType::Storage { read_only: false };
-/// A parameter block (a `var<uniform>` of the WGSL) in a list of [`crate::passes::pass_layout`]:
+/// A parameter block (a `var<uniform>` of the WGSL) in a list of `passes::pass_layout`:
 /// a uniform buffer, or a read-only storage buffer on software adapters
 /// ([`crate::shader::ParamsBinding`]), which `pass_layout` picks for its device.
 pub const UNIFORM: wgpu::BufferBindingType = wgpu::BufferBindingType::Uniform;

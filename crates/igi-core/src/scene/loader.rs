@@ -842,7 +842,7 @@ fn light_power_f64(intensity: Vec3) -> f64 {
 
 /// The largest value that channel `channel` (0, 1, 2: r, g, b) of light `index` may take,
 /// the other channels and lights as they are, for the lights' total power to stay within
-/// f32 as loading requires ([`check_total_power`]); for editors such as the viewer's
+/// f32 as loading requires (`check_total_power`); for editors such as the viewer's
 /// light panel, where a drag could otherwise push the sum past it at run time.
 pub fn max_light_intensity(lights: &[PointLight], index: usize, channel: usize) -> f32 {
     let others: f64 = lights
