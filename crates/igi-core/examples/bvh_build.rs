@@ -121,6 +121,11 @@ fn main() {
         // page on the 2-core machine; docs/PERFORMANCE.md attempt 113).
         out!("minor page faults of the first build: {faults}");
     }
+    // Single builds are faster with huge pages: figures compare only where both had them.
+    out!(
+        "transparent huge pages offered for {:.1} MiB of the last build's buffers",
+        s.huge_page_bytes as f64 / (1 << 20) as f64
+    );
     // Equal hashes: the same tree, for checking that a change to the builder keeps it.
     let mut hash = 0xcbf2_9ce4_8422_2325u64;
     for byte in bytemuck::cast_slice::<_, u8>(&bvh.nodes)

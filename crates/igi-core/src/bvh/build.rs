@@ -613,6 +613,7 @@ fn build_impl<T: Vertices>(tri: &[T], limits: Limits) -> Bvh {
         start,
     );
     build_stats.phases = phases.done();
+    build_stats.huge_page_bytes = huge.advised_bytes();
     Bvh {
         nodes,
         tri_rows,
@@ -1655,6 +1656,7 @@ fn stats(
         oversized_leaves: t.oversized_leaves,
         sah_cost: (SAH_TRAVERSAL_COST as f64 + cost) as f32,
         phases: vec![],
+        huge_page_bytes: 0,
     }
 }
 
@@ -1703,6 +1705,7 @@ pub(super) fn stats_by_walk(bvh: &Bvh) -> BuildStats {
     );
     s.build_ms = bvh.build_stats.build_ms;
     s.phases = bvh.build_stats.phases.clone();
+    s.huge_page_bytes = bvh.build_stats.huge_page_bytes;
     s
 }
 

@@ -21,6 +21,8 @@ pub(super) const HUGE_PAGE: usize = 2 << 20;
 #[derive(Debug)]
 pub(super) struct HugePages {
     budget: usize,
+    /// Bytes advised so far.
+    advised: usize,
 }
 
 impl HugePages {
@@ -34,13 +36,24 @@ impl HugePages {
         } else {
             0
         };
-        HugePages { budget: free / 2 }
+        HugePages {
+            budget: free / 2,
+            advised: 0,
+        }
     }
 
     /// A budget of nothing: no advice (tests of the build's parts).
     #[cfg(test)]
     pub(super) fn none() -> HugePages {
-        HugePages { budget: 0 }
+        HugePages {
+            budget: 0,
+            advised: 0,
+        }
+    }
+
+    /// Bytes advised so far ([`super::BuildStats::huge_page_bytes`]).
+    pub(super) fn advised_bytes(&self) -> usize {
+        self.advised
     }
 
     /// Asks for huge pages over the aligned inside of `buf` (memory not yet written, so
@@ -55,6 +68,7 @@ impl HugePages {
             return;
         }
         self.budget -= pages;
+        self.advised += len;
         #[cfg(target_os = "linux")]
         // SAFETY: advice on whole pages inside `buf`'s allocation, which the caller owns;
         // MADV_HUGEPAGE changes how its pages are mapped, not their contents or validity.
@@ -146,15 +160,24 @@ Node 0, zone   Normal   9368   7228   4695   3026   1810   1097    664    388   
         let (_, len) = huge_span(buf.as_ptr() as usize, buf.len()).expect("an aligned span");
         let pages = len / HUGE_PAGE;
         assert!(pages >= 4);
-        let mut small = HugePages { budget: pages - 1 };
+        let mut small = HugePages {
+            budget: pages - 1,
+            advised: 0,
+        };
         small.advise(&buf);
         assert_eq!(small.budget, pages - 1, "advice beyond the budget");
-        let mut enough = HugePages { budget: pages + 3 };
+        assert_eq!(small.advised_bytes(), 0);
+        let mut enough = HugePages {
+            budget: pages + 3,
+            advised: 0,
+        };
         enough.advise(&buf);
         assert_eq!(enough.budget, 3);
+        assert_eq!(enough.advised_bytes(), len);
         // A buffer smaller than a huge page takes nothing from the budget.
         let tiny: Box<[MaybeUninit<u8>]> = Box::new_uninit_slice(4096);
         enough.advise(&tiny);
         assert_eq!(enough.budget, 3);
+        assert_eq!(enough.advised_bytes(), len);
     }
 }
