@@ -13,7 +13,8 @@ use std::io::Write;
 use std::path::PathBuf;
 use std::time::Instant;
 
-use igi_core::bvh::{Bvh, BvhBuilder};
+use igi_core::bvh::timing::time_builds;
+use igi_core::bvh::BvhBuilder;
 use igi_core::scene::{load_scene, Triangle};
 use igi_core::Vec3;
 
@@ -65,88 +66,9 @@ fn main() {
         triangles.len(),
         t.elapsed().as_secs_f64() * 1e3
     );
-    out!("builder: {}", builder.name());
-    out!(
-        "threads: {}",
-        std::thread::available_parallelism().map_or(1, |n| n.get())
-    );
-
-    let mut times = vec![];
-    let mut phases: Vec<(&str, Vec<f64>)> = vec![];
-    let mut bvh = None;
-    let cpu_start = process_cpu_seconds();
-    let mut first_faults = None;
-    for _ in 0..runs {
-        let faults = minor_faults();
-        let t = Instant::now();
-        let b = Bvh::build_with(&triangles, builder);
-        times.push(t.elapsed().as_secs_f64() * 1e3);
-        if first_faults.is_none() {
-            first_faults = minor_faults().zip(faults).map(|(b, a)| b - a);
-        }
-        for (k, &(name, ms)) in b.build_stats.phases.iter().enumerate() {
-            if k == phases.len() {
-                phases.push((name, vec![]));
-            }
-            phases[k].1.push(ms);
-        }
-        bvh = Some(b);
-    }
-    let cpu = process_cpu_seconds()
-        .zip(cpu_start)
-        .map(|(b, a)| (b - a) / runs as f64);
-    let bvh = bvh.expect("at least one run");
-    times.sort_by(f64::total_cmp);
-    let s = &bvh.build_stats;
-    if let Some(cpu) = cpu {
-        // Less sensitive than wall time to other processes on a small machine.
-        out!("CPU time per build, all threads: {:.0} ms", cpu * 1e3);
-    }
-    out!(
-        "build: median {:.1} ms of {runs} (min {:.1}, max {:.1})",
-        times[runs / 2],
-        times[0],
-        times[runs - 1]
-    );
-    let medians: Vec<String> = phases
-        .iter_mut()
-        .map(|(name, ms)| {
-            ms.sort_by(f64::total_cmp);
-            format!("{name} {:.1}", ms[ms.len() / 2])
-        })
-        .collect();
-    out!("phases, median ms: {}", medians.join(", "));
-    if let Some(faults) = first_faults {
-        // What the first build in a new process pays for fresh memory (about 1.7 us a
-        // page on the 2-core machine; docs/PERFORMANCE.md attempt 113).
-        out!("minor page faults of the first build: {faults}");
-    }
-    // Single builds are faster with huge pages: figures compare only where both had them.
-    out!(
-        "transparent huge pages offered for {:.1} MiB of the last build's buffers",
-        s.huge_page_bytes as f64 / (1 << 20) as f64
-    );
-    // Equal hashes: the same tree, for checking that a change to the builder keeps it.
-    let mut hash = 0xcbf2_9ce4_8422_2325u64;
-    for byte in bytemuck::cast_slice::<_, u8>(&bvh.nodes)
-        .iter()
-        .chain(bytemuck::cast_slice::<_, u8>(&bvh.tri_rows))
-        .chain(bytemuck::cast_slice::<_, u8>(&bvh.tri_order))
-    {
-        hash = (hash ^ *byte as u64).wrapping_mul(0x100_0000_01b3);
-    }
-    out!("tree hash (FNV-1a of nodes, rows and slot order): {hash:016x}");
-    out!(
-        "references {}, nodes {} ({} KiB), leaves {}, max depth {}, max leaf {}, oversized leaves {}, SAH cost {:.2}",
-        s.references,
-        s.nodes,
-        s.nodes * std::mem::size_of::<igi_core::bvh::BvhNode>() / 1024,
-        s.leaves,
-        s.max_depth,
-        s.max_leaf_size,
-        s.oversized_leaves,
-        s.sah_cost
-    );
+    let timing = time_builds(&triangles, builder, runs, |_| {});
+    out!("{timing}");
+    let bvh = timing.bvh;
 
     // Primary rays of the scene's camera, on one core: a rough figure for the CPU twin.
     let Some(scene) = scene.filter(|_| !build_only) else {
@@ -218,31 +140,4 @@ fn load_obj(path: &std::path::Path) -> Vec<Triangle> {
         }
     }
     out
-}
-
-/// User + system time of this process so far (all threads, finished ones included), from
-/// /proc/self/stat (Linux; clock ticks of 10 ms: meaningful over several builds).
-/// Fields of /proc/self/stat after the command name (which ends with ')'), numbered
-/// from 0 (the state); None where there is no such file (not Linux).
-fn proc_stat_fields() -> Option<Vec<u64>> {
-    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
-    let rest = &stat[stat.rfind(')')? + 2..];
-    // The state is a letter; the fields wanted here are numbers.
-    Some(
-        rest.split_whitespace()
-            .map(|f| f.parse().unwrap_or(0))
-            .collect(),
-    )
-}
-
-/// Minor page faults of the process so far (minflt, field 7).
-fn minor_faults() -> Option<u64> {
-    proc_stat_fields()?.get(7).copied()
-}
-
-/// CPU time of the process so far, all threads (utime and stime, fields 11 and 12, in
-/// ticks of 1/100 s).
-fn process_cpu_seconds() -> Option<f64> {
-    let fields = proc_stat_fields()?;
-    Some((fields.get(11)? + fields.get(12)?) as f64 / 100.0)
 }

@@ -12,6 +12,7 @@
 //!   Traversal", JCGT 2013), the watertight ray-triangle test (Woop, Benthin and Wald,
 //!   JCGT 2013), closest-hit and any-hit traversal, brute-force references, and the ray
 //!   origin offset of Wächter and Binder (Ray Tracing Gems, ch. 6).
+//! * `timing`: the build timed (`igi bench build`, the `bvh_build` example).
 //!
 //! The WGSL twin must run the same algorithm in the same order: any change here is a
 //! change there (the GPU test `crates/igi-gpu/tests/traverse_gpu.rs` compares them).
@@ -19,6 +20,7 @@
 mod build;
 mod huge_pages;
 mod split;
+pub mod timing;
 mod traverse;
 
 #[cfg(test)]

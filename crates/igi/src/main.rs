@@ -62,6 +62,26 @@ enum BenchSub {
     /// set (random segments and rays, or the VPL shadow rays of a real frame), in the ray
     /// file format of docs/BENCHMARKS.md so another tracer can trace the very same rays.
     Rays(RaysArgs),
+    /// The BVH build alone, on the CPU: median wall time of several builds in this
+    /// process, its phases, the tree's size and SAH cost.
+    Build(BuildArgs),
+}
+
+#[derive(Args)]
+struct BuildArgs {
+    /// Scene files (TOML), or builtin:NAME.
+    #[arg(required = true)]
+    scenes: Vec<String>,
+    /// Builds of each scene in this process; the median is reported. Later builds reuse
+    /// memory that the first had to map: `--runs 1` in a new process is what `igi render`
+    /// pays.
+    #[arg(long, default_value_t = 5)]
+    runs: u32,
+    #[command(flatten)]
+    bvh: BvhChoice,
+    /// No progress bar.
+    #[arg(long)]
+    quiet: bool,
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -1124,6 +1144,9 @@ fn main() -> ExitCode {
         Command::Info => info(),
         Command::Bench(cmd) => match &cmd.sub {
             Some(BenchSub::Rays(r)) => bench_rays(r),
+            Some(BenchSub::Build(b)) => {
+                igi::bench::build::run(&b.scenes, b.runs, b.bvh.builder.into(), b.quiet)
+            }
             None => bench(&cmd.args),
         },
         Command::Compare { image, reference } => compare(image, reference),

@@ -1431,3 +1431,58 @@ fn output_paths_that_name_directories_say_so() {
     }
     assert_one_error_line(&out, &["directory '/proc' takes no new files"]);
 }
+
+#[test]
+fn bench_build_times_every_scene_and_needs_no_adapter() {
+    // No GPU is touched: the build runs on the CPU, so this runs wherever the tests do.
+    let d = temp_dir("bench-build");
+    let scene = scene_with_obj(&d, QUAD);
+    let scene = scene.to_str().unwrap();
+    let out = igi(&[
+        "bench",
+        "build",
+        "builtin:cornell-box",
+        scene,
+        "--runs",
+        "3",
+        "--bvh",
+        "binned",
+    ]);
+    assert!(out.status.success(), "{out:?}");
+    let text = String::from_utf8_lossy(&out.stdout);
+    // One report per scene, in order, with the figures the build bench reads.
+    let reports: Vec<&str> = text.split("builder: binned").collect();
+    assert_eq!(reports.len(), 3, "two reports in\n{text}");
+    assert!(
+        reports[0].starts_with("builtin:cornell-box: 30 triangles"),
+        "{text}"
+    );
+    assert!(
+        reports[1].contains("build: median") && reports[1].contains(" of 3 "),
+        "{text}"
+    );
+    assert!(
+        reports[1].contains(&format!("{scene}: 2 triangles")),
+        "{text}"
+    );
+    assert!(reports[2].contains("references 2, nodes 1 ("), "{text}");
+}
+
+#[test]
+fn bench_build_refuses_bad_input_before_measuring() {
+    let d = temp_dir("bench-build-bad");
+    // The second scene is missing: nothing is measured, one error names it.
+    let missing = d.join("missing.toml");
+    let out = igi(&[
+        "bench",
+        "build",
+        "builtin:cornell-box",
+        missing.to_str().unwrap(),
+    ]);
+    assert_one_error_line(&out, &["missing.toml"]);
+    assert!(out.stdout.is_empty(), "measured before the error: {out:?}");
+    let out = igi(&["bench", "build", "builtin:cornell-box", "--runs", "0"]);
+    assert_one_error_line(&out, &["--runs"]);
+    let out = igi(&["bench", "build", "builtin:teapot"]);
+    assert_one_error_line(&out, &["teapot", "cornell-box"]);
+}
