@@ -25,11 +25,6 @@ build_ms() { "$1" "$SCENE" "$2" --build-only | awk '/^build: median/ {print $3}'
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 echo "$(date -u +%FT%TZ) $(nproc) cores, scene $SCENE"
-# Single builds are faster where the kernel gives the build huge pages (see
-# crates/igi-core/src/bvh/huge_pages.rs): say whether it did, and what it is set to.
-thp=/sys/kernel/mm/transparent_hugepage
-echo "transparent huge pages: enabled $(cat $thp/enabled 2>/dev/null || echo '?'), defrag $(cat $thp/defrag 2>/dev/null || echo '?')"
-echo "$1: $("$1" "$SCENE" 1 --build-only | grep -E '^transparent huge pages' || echo 'no huge-page line (an older build)')"
 for r in $(seq "$ROUNDS"); do
   first=""
   for k in $(seq $#); do

@@ -18,7 +18,6 @@
 //! change there (the GPU test `crates/igi-gpu/tests/traverse_gpu.rs` compares them).
 
 mod build;
-mod huge_pages;
 mod split;
 pub mod timing;
 mod traverse;
@@ -233,10 +232,6 @@ pub struct BuildStats {
     /// their split clipping), the node arrays' allocation, the tree, the layout, the
     /// rows.
     pub phases: Vec<(&'static str, f64)>,
-    /// Bytes of the build's buffers that it offered transparent huge pages before writing
-    /// them (Linux; 0 where the kernel had no free 2 MiB blocks to spare, or elsewhere):
-    /// a build in a new process is faster with them, so figures compare only alike.
-    pub huge_page_bytes: usize,
 }
 
 /// One row of [`Bvh::tri_rows`]: one coordinate (x, y or z) of a slot's vertices 0, 1

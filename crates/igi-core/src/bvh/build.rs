@@ -32,7 +32,6 @@ use std::time::Instant;
 
 use glam::{Vec3, Vec3A};
 
-use super::huge_pages::HugePages;
 use super::{
     BuildStats, Bvh, BvhChild, BvhNode, TriRow, MAX_DEPTH, MAX_LEAF_SIZE, SAH_BINS,
     SAH_INTERSECT_COST, SAH_TRAVERSAL_COST,
@@ -345,15 +344,8 @@ where
 /// items i are `item(i)`, and `reduce` runs over each chunk of the first once it is
 /// written (its results come in chunk order). The threads write the memory once: zeroed
 /// first, as `vec!` does, it would be written twice, the first time in one thread when
-/// the allocator reuses memory (docs/PERFORMANCE.md attempt 111). Both are offered huge
-/// pages before they are written (`huge`).
-fn par_vec2<A, B, R, I, G>(
-    n: usize,
-    spare: usize,
-    huge: &mut HugePages,
-    item: I,
-    reduce: G,
-) -> (Vec<A>, Vec<B>, Vec<R>)
+/// the allocator reuses memory (docs/PERFORMANCE.md attempt 111).
+fn par_vec2<A, B, R, I, G>(n: usize, spare: usize, item: I, reduce: G) -> (Vec<A>, Vec<B>, Vec<R>)
 where
     A: Send + Sync,
     B: Send,
@@ -363,8 +355,6 @@ where
 {
     let mut va: Vec<A> = Vec::with_capacity(n + spare);
     let mut vb: Vec<B> = Vec::with_capacity(n);
-    huge.advise(va.spare_capacity_mut());
-    huge.advise(vb.spare_capacity_mut());
     let results = par_chunks_zip(
         &mut va.spare_capacity_mut()[..n],
         &mut vb.spare_capacity_mut()[..n],
@@ -516,12 +506,8 @@ fn build_impl<T: Vertices>(tri: &[T], limits: Limits) -> Bvh {
     // An even capacity in all, so that the layout can have the allocation (two
     // references to a node, see reuse_vec).
     let spare = if limits.split { count } else { count % 2 };
-    // The large buffers below are offered transparent huge pages before they are first
-    // written, while the kernel has free 2 MiB blocks to spare (see huge_pages).
-    let mut huge = HugePages::free_now();
-    let (mut prims, bounds, mut cbounds, tri_area) = whole_references(tri, spare, &mut huge);
+    let (mut prims, bounds, mut cbounds, tri_area) = whole_references(tri, spare);
     let mut ids: Vec<u32> = Vec::with_capacity(count + spare);
-    huge.advise(ids.spare_capacity_mut());
     ids.extend(0..count as u32);
     phases.lap("references");
     if limits.split {
@@ -540,8 +526,6 @@ fn build_impl<T: Vertices>(tri: &[T], limits: Limits) -> Bvh {
     let places = refs.max(2) - 1;
     let mut nodes: Box<Places<BvhNode>> = Box::new_uninit_slice(places);
     let mut info: Box<Places<NodeInfo>> = Box::new_uninit_slice(places);
-    huge.advise(&nodes);
-    huge.advise(&info);
     if cfg!(debug_assertions) {
         // Where assertions are on (the tests), every place's info starts out written
         // with an interior count of 0, which no set node has, and each read checks it.
@@ -613,7 +597,6 @@ fn build_impl<T: Vertices>(tri: &[T], limits: Limits) -> Bvh {
         start,
     );
     build_stats.phases = phases.done();
-    build_stats.huge_page_bytes = huge.advised_bytes();
     Bvh {
         nodes,
         tri_rows,
@@ -655,13 +638,11 @@ impl Phases {
 pub(super) fn whole_references<T: Vertices>(
     tri: &[T],
     spare: usize,
-    huge: &mut HugePages,
 ) -> (Vec<PrimRef>, Aabb, Aabb, Vec<f32>) {
     let count = tri.len();
     let (prims, areas, chunk_bounds) = par_vec2(
         count,
         spare,
-        huge,
         |i| {
             let [a, b, c] = tri[i].vertices().map(Vec3A::from);
             let (lo, hi) = (a.min(b).min(c), a.max(b).max(c));
@@ -1656,7 +1637,6 @@ fn stats(
         oversized_leaves: t.oversized_leaves,
         sah_cost: (SAH_TRAVERSAL_COST as f64 + cost) as f32,
         phases: vec![],
-        huge_page_bytes: 0,
     }
 }
 
@@ -1705,7 +1685,6 @@ pub(super) fn stats_by_walk(bvh: &Bvh) -> BuildStats {
     );
     s.build_ms = bvh.build_stats.build_ms;
     s.phases = bvh.build_stats.phases.clone();
-    s.huge_page_bytes = bvh.build_stats.huge_page_bytes;
     s
 }
 

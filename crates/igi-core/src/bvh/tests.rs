@@ -908,8 +908,7 @@ fn split_pieces_cover_their_triangle() {
 }
 
 fn check_pieces(tris: &[[Vec3; 3]], r: &mut Pcg64) {
-    let (mut prims, bounds, _, areas) =
-        super::build::whole_references(tris, 0, &mut super::huge_pages::HugePages::none());
+    let (mut prims, bounds, _, areas) = super::build::whole_references(tris, 0);
     let mut ids: Vec<u32> = (0..tris.len() as u32).collect();
     super::split::split_references(&mut prims, &mut ids, &areas, &bounds, tris);
     assert_eq!(prims.len(), ids.len());

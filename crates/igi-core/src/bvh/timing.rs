@@ -1,8 +1,7 @@
 //! Timing of the BVH build, for `igi bench build` and the `bvh_build` example: the
 //! build that replaces OptiX's acceleration structure in Marques and Santos' system, run
 //! several times in one process, with what a reader needs to compare two figures (the
-//! phases, the threads, the page faults and huge pages of the first build, a hash of the
-//! tree). The build target of docs/PERFORMANCE.md is measured with it
+//! phases, the threads, the page faults of the first build, a hash of the tree). The build target of docs/PERFORMANCE.md is measured with it
 //! (`scripts/build-bench.sh`).
 
 use std::fmt;
@@ -103,8 +102,8 @@ pub fn tree_hash(bvh: &Bvh) -> u64 {
     hash
 }
 
-/// The report, one figure a line; `scripts/build-bench.sh` reads the lines that begin
-/// with "build: median" and "transparent huge pages".
+/// The report, one figure a line; `scripts/build-bench.sh` reads the line that begins
+/// with "build: median".
 impl fmt::Display for BuildTiming {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let runs = self.times_ms.len();
@@ -129,13 +128,7 @@ impl fmt::Display for BuildTiming {
         if let Some(faults) = self.first_build_faults {
             writeln!(f, "minor page faults of the first build: {faults}")?;
         }
-        // Single builds are faster with huge pages: figures compare only where both had them.
         let s = &self.bvh.build_stats;
-        writeln!(
-            f,
-            "transparent huge pages offered for {:.1} MiB of the last build's buffers",
-            s.huge_page_bytes as f64 / (1 << 20) as f64
-        )?;
         writeln!(
             f,
             "tree hash (FNV-1a of nodes, rows and slot order): {:016x}",
