@@ -1,8 +1,8 @@
 //! Timing of the BVH build, for `igi bench build` and the `bvh_build` example: the
 //! build that replaces OptiX's acceleration structure in Marques and Santos' system, run
 //! several times in one process, with what a reader needs to compare two figures (the
-//! phases, the threads, the page faults of the first build, a hash of the tree). The build target of docs/PERFORMANCE.md is measured with it
-//! (`scripts/build-bench.sh`).
+//! phases, the threads, the page faults of the first build, a hash of the tree). The
+//! build target of docs/PERFORMANCE.md is measured with it (`scripts/build-bench.sh`).
 
 use std::fmt;
 use std::time::Instant;
@@ -30,6 +30,8 @@ pub struct BuildTiming {
 }
 
 impl BuildTiming {
+    /// The median build time (the upper of the two middle builds for an even count, as
+    /// `igi bench rays` takes its median run).
     pub fn median_ms(&self) -> f64 {
         self.times_ms[self.times_ms.len() / 2]
     }
