@@ -1480,6 +1480,7 @@ fn bench_build_refuses_bad_input_before_measuring() {
         missing.to_str().unwrap(),
     ]);
     assert_one_error_line(&out, &["missing.toml"]);
+    common::assert_no_repeated_clause(&String::from_utf8_lossy(&out.stderr));
     assert!(out.stdout.is_empty(), "measured before the error: {out:?}");
     let out = igi(&["bench", "build", "builtin:cornell-box", "--runs", "0"]);
     assert_one_error_line(&out, &["--runs"]);

@@ -3,7 +3,7 @@
 //! figures and their lines are those of the `bvh_build` example, whose rounds
 //! `scripts/build-bench.sh` pairs for the build target of docs/PERFORMANCE.md.
 
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 use igi_core::bvh::timing::time_builds;
 use igi_core::bvh::BvhBuilder;
 use indicatif::{ProgressBar, ProgressStyle};
@@ -19,7 +19,8 @@ pub fn run(scenes: &[String], runs: u32, builder: BvhBuilder, quiet: bool) -> Re
     let mut loaded = Vec::with_capacity(scenes.len());
     for arg in scenes {
         let t = Instant::now();
-        let scene = super::run::load(arg).with_context(|| format!("scene {arg}"))?;
+        // The loaders' errors name the file (or the built-in scene) already.
+        let scene = super::run::load(arg)?;
         loaded.push((arg, scene, t.elapsed()));
     }
     for (k, (arg, scene, load_time)) in loaded.into_iter().enumerate() {
