@@ -6,6 +6,7 @@
 //! and CPU references of each pass's math used by the tests (paper section 4).
 
 pub mod bvh;
+pub mod fingerprint;
 pub mod image;
 pub mod metrics;
 pub mod rays;

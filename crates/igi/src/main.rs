@@ -1014,14 +1014,14 @@ fn bench_rays(args: &RaysArgs) -> Result<()> {
         };
         // A hash of every answer, so that two traversals (or builds) of the same ray file
         // can be checked to answer the same, not only to be as fast.
-        let answers = timing
-            .results
-            .iter()
-            .copied()
-            .chain(timing.distances.iter().map(|d| d.to_bits()))
-            .fold(0xcbf29ce484222325u64, |h, w| {
-                (h ^ w as u64).wrapping_mul(0x100000001b3)
-            });
+        let answers = igi_core::fingerprint::fnv1a(
+            timing
+                .results
+                .iter()
+                .copied()
+                .chain(timing.distances.iter().map(|d| d.to_bits()))
+                .map(u64::from),
+        );
         println!(
             "{name}: {} rays, {} {} ({:.1}%, answers hash {answers:016x}), median {median:.3} ms over {} runs (min {:.3}, max {:.3}): {:.3} G rays/s",
             rays.len(),

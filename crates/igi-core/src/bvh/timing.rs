@@ -93,15 +93,13 @@ pub fn time_builds(
 /// FNV-1a over the nodes, the rows and the slot order: equal hashes, the same tree (for
 /// checking that a change to the builder keeps it).
 pub fn tree_hash(bvh: &Bvh) -> u64 {
-    let mut hash = 0xcbf2_9ce4_8422_2325u64;
-    for byte in bytemuck::cast_slice::<_, u8>(&bvh.nodes)
-        .iter()
-        .chain(bytemuck::cast_slice::<_, u8>(&bvh.tri_rows))
-        .chain(bytemuck::cast_slice::<_, u8>(&bvh.tri_order))
-    {
-        hash = (hash ^ *byte as u64).wrapping_mul(0x100_0000_01b3);
-    }
-    hash
+    crate::fingerprint::fnv1a(
+        bytemuck::cast_slice::<_, u8>(&bvh.nodes)
+            .iter()
+            .chain(bytemuck::cast_slice::<_, u8>(&bvh.tri_rows))
+            .chain(bytemuck::cast_slice::<_, u8>(&bvh.tri_order))
+            .map(|&byte| u64::from(byte)),
+    )
 }
 
 /// The report, one figure a line; `scripts/build-bench.sh` reads the line that begins
