@@ -12,16 +12,16 @@
 # process and single builds in new processes) and a round of 5 one-thread builds of the
 # last BIN (RAYON_NUM_THREADS=1): that round's median over the set's two-thread rounds
 # of the same binary is the speed-up the second core gave in that minute (about 1.9 with
-# both cores, about 1 with one). The log goes to LOG (default build-sampler.log); at the
-# end (or on Ctrl-C) the pooled figures of every set are printed: per binary the median,
-# p90 and range of the rounds and single builds and how many took over 100 ms; the
-# one-thread rounds and the speed-ups; and each set with a single build over 100 ms, with
-# its speed-up.
+# both cores, about 1 with one). The log is appended to LOG (default
+# target/build-sampler.log); at the end (or on Ctrl-C) the pooled figures of this run's
+# sets are printed: per binary the median, p90 and range of the rounds and single builds
+# and how many took over 100 ms; the one-thread rounds and the speed-ups; and each set
+# with a single build over 100 ms, with its speed-up.
 set -euo pipefail
 MINUTES=${1:-60}
 shift || true
 INTERVAL=${INTERVAL:-180}
-LOG=${LOG:-build-sampler.log}
+LOG=${LOG:-target/build-sampler.log}
 SCENE=${SCENE:-../shared/scenes/conference/scene.toml}
 export SCENE
 if [ $# -eq 0 ]; then
@@ -32,6 +32,7 @@ fi
 for bin in "$@"; do
   [ -x "$bin" ] || { echo "build-sampler: $bin is not an executable bvh_build" >&2; exit 1; }
 done
+mkdir -p "$(dirname "$LOG")"
 here=$(cd "$(dirname "$0")" && pwd)
 last=${!#}
 
@@ -47,6 +48,12 @@ data, one, speedup, slow, rounds_of_last = {}, [], {}, [], {}
 start = binary = None
 sets = 0
 for line in open(log):
+    if re.match(r'# \S+ build-sampler:', line):
+        # A new run appended to the same log: pool this run's sets only.
+        data, one, speedup, slow, rounds_of_last = {}, [], {}, [], {}
+        start = binary = None
+        sets = 0
+        continue
     m = re.match(r'=== (\S+) load', line)
     if m:
         start, binary, sets = m.group(1), None, sets + 1
