@@ -373,6 +373,44 @@ impl Renderer {
         ))
     }
 
+    /// One of the last frame's per-pixel buffers by its label (waits for it), as many
+    /// RGBA values as the image has pixels (buffers at the indirect term's resolution use
+    /// the first `low_resolution` of them): "direct", "gbuffer position", "gbuffer
+    /// normal", "gbuffer geometric normal", "gbuffer albedo", "mirror position", "mirror
+    /// normal", "mirror geometric normal", "mirror weight", "mirror irradiance", "mirror
+    /// irradiance after discontinuity", "irradiance", "irradiance after discontinuity",
+    /// "irradiance full resolution", "color". For the tests of the passes' CPU twins.
+    pub fn read_frame_buffer(
+        &self,
+        ctx: &GpuContext,
+        label: &str,
+    ) -> Result<Vec<[f32; 4]>, GpuError> {
+        let Some(b) = self.images.as_ref() else {
+            return Err(GpuError::Device("no frame rendered yet".into()));
+        };
+        let buffer = match label {
+            "direct" => &b.direct,
+            "gbuffer position" => &b.position,
+            "gbuffer normal" => &b.normal,
+            "gbuffer geometric normal" => &b.geometric,
+            "gbuffer albedo" => &b.albedo,
+            "mirror position" => &b.mirror[0],
+            "mirror normal" => &b.mirror[1],
+            "mirror geometric normal" => &b.mirror[2],
+            "mirror weight" => &b.mirror[3],
+            "mirror irradiance" => &b.mirror_irradiance,
+            "mirror irradiance after discontinuity" => &b.mirror_filtered,
+            "irradiance" => &b.irradiance,
+            "irradiance after discontinuity" => &b.filtered_low,
+            "irradiance full resolution" => &b.filtered,
+            "color" => &b.color,
+            _ => return Err(GpuError::Device(format!("no frame buffer called {label:?}"))),
+        };
+        let mut values: Vec<[f32; 4]> = ctx.read_buffer(buffer)?;
+        values.truncate(b.width as usize * b.height as usize);
+        Ok(values)
+    }
+
     /// VPLs stored by the last submitted frame (waits for it).
     pub fn vpl_count(&self, ctx: &GpuContext) -> Result<u32, GpuError> {
         let header: Vec<u32> = ctx.read_buffer(&self.vpl_header)?;
