@@ -32,35 +32,35 @@ pub struct PassSource {
 pub const SOURCES: &[PassSource] = &[
     PassSource {
         name: "vpl",
-        wgsl: include_str!("../shaders/vpl.wgsl"),
+        wgsl: include_str!("vpl/vpl.wgsl"),
         gathers: false,
         upsamples: false,
         subgroups: false,
     },
     PassSource {
         name: "direct",
-        wgsl: include_str!("../shaders/direct.wgsl"),
+        wgsl: include_str!("direct/direct.wgsl"),
         gathers: true,
         upsamples: false,
         subgroups: false,
     },
     PassSource {
         name: "indirect",
-        wgsl: include_str!("../shaders/indirect.wgsl"),
+        wgsl: include_str!("indirect/indirect.wgsl"),
         gathers: true,
         upsamples: false,
         subgroups: false,
     },
     PassSource {
         name: "filter",
-        wgsl: include_str!("../shaders/filter.wgsl"),
+        wgsl: include_str!("filter/filter.wgsl"),
         gathers: false,
         upsamples: true,
         subgroups: false,
     },
     PassSource {
         name: "rays",
-        wgsl: include_str!("../shaders/rays.wgsl"),
+        wgsl: include_str!("../raybench/rays.wgsl"),
         gathers: false,
         upsamples: false,
         subgroups: false,
@@ -69,8 +69,8 @@ pub const SOURCES: &[PassSource] = &[
         name: "rays_refill",
         // rays.wgsl's bindings and kernels, then the refill schedule's.
         wgsl: concat!(
-            include_str!("../shaders/rays.wgsl"),
-            include_str!("../shaders/rays_refill.wgsl")
+            include_str!("../raybench/rays.wgsl"),
+            include_str!("../raybench/rays_refill.wgsl")
         ),
         gathers: false,
         upsamples: false,
@@ -78,14 +78,14 @@ pub const SOURCES: &[PassSource] = &[
     },
     PassSource {
         name: "compose",
-        wgsl: include_str!("../shaders/compose.wgsl"),
+        wgsl: include_str!("compose/compose.wgsl"),
         gathers: false,
         upsamples: true,
         subgroups: false,
     },
     PassSource {
         name: "display",
-        wgsl: include_str!("../shaders/display.wgsl"),
+        wgsl: include_str!("display/display.wgsl"),
         gathers: false,
         upsamples: false,
         subgroups: false,
