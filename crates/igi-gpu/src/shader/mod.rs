@@ -5,12 +5,14 @@
 
 use crate::passes::PassSource;
 
+pub mod resolve;
+
 /// Shared WGSL modules, in the order they are prepended.
-pub const SCENE: &str = include_str!("shaders/scene.wgsl");
-pub const TRAVERSE: &str = include_str!("shaders/traverse.wgsl");
-pub const FRAME: &str = include_str!("shaders/frame.wgsl");
-pub const GATHER: &str = include_str!("shaders/gather.wgsl");
-pub const UPSAMPLE: &str = include_str!("shaders/upsample.wgsl");
+pub const SCENE: &str = include_str!("../shaders/scene.wgsl");
+pub const TRAVERSE: &str = include_str!("../shaders/traverse.wgsl");
+pub const FRAME: &str = include_str!("../shaders/frame.wgsl");
+pub const GATHER: &str = include_str!("../shaders/gather.wgsl");
+pub const UPSAMPLE: &str = include_str!("../shaders/upsample.wgsl");
 
 /// A pass's full shader: the shared modules, then the pass, its parameter blocks bound as
 /// uniform buffers (as written).
