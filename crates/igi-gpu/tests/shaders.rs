@@ -1,6 +1,7 @@
 //! Every composed shader parses and validates with naga (a broken shader fails here, not
-//! in front of a user), and every host/GPU struct has the size and field offsets that
-//! the WGSL declares.
+//! in front of a user), so does every shared module composed with only its own imports
+//! (a module that relies on what its includer declares fails here), and every host/GPU
+//! struct has the size and field offsets that the WGSL declares.
 
 mod common;
 
@@ -8,7 +9,7 @@ use common::wgsl_constant;
 use igi_gpu::layout::{
     BvhNode, DisplayParams, FrameParams, GpuLight, GpuMaterial, TriShading, Vpl,
 };
-use igi_gpu::shader::{compose_for, ParamsBinding};
+use igi_gpu::shader::{compose_for, try_compose, ParamsBinding, MODULES, SOURCES};
 use std::mem::{offset_of, size_of};
 
 fn parse_and_validate(name: &str, src: &str) -> naga::Module {
@@ -41,7 +42,7 @@ fn validate_with(name: &str, src: &str, subgroups: bool) -> naga::Module {
 /// adapters do (read-only storage ones).
 #[test]
 fn every_pass_shader_validates() {
-    let passes = igi_gpu::passes::SOURCES;
+    let passes = SOURCES;
     assert!(passes.len() >= 4);
     for binding in ParamsBinding::ALL {
         for pass in passes {
@@ -51,12 +52,54 @@ fn every_pass_shader_validates() {
     }
 }
 
+/// Each module with only what it imports, as GPUs and as software adapters get it: a
+/// module that used an identifier it neither declares nor imports would not parse.
+#[test]
+fn every_module_validates_with_its_own_imports() {
+    assert!(MODULES.len() >= 10);
+    for binding in ParamsBinding::ALL {
+        for (name, wgsl) in MODULES {
+            let composed =
+                try_compose(name, wgsl, binding).unwrap_or_else(|e| panic!("{name}.wgsl: {e}"));
+            parse_and_validate(&format!("{name} ({binding:?} params)"), &composed);
+        }
+    }
+}
+
+/// Every module is registered once, and some pass imports it (directly or not).
+#[test]
+fn every_module_is_named_once_and_used() {
+    for (i, (name, _)) in MODULES.iter().enumerate() {
+        assert!(
+            MODULES[..i].iter().all(|(n, _)| n != name),
+            "{name} is registered twice"
+        );
+        let used = SOURCES.iter().any(|pass| {
+            let mut pending: Vec<&str> = vec![pass.wgsl];
+            let mut seen: Vec<&str> = Vec::new();
+            while let Some(src) = pending.pop() {
+                for import in igi_gpu::shader::resolve::imports("", src).unwrap() {
+                    if import == *name {
+                        return true;
+                    }
+                    if !seen.contains(&import) {
+                        seen.push(import);
+                        pending.extend(igi_gpu::shader::module(import));
+                    }
+                }
+            }
+            false
+        });
+        assert!(used, "no pass imports {name}.wgsl");
+    }
+}
+
 /// Software adapters get no uniform buffers at all (lavapipe recompiles shaders whose
 /// branches depend on uniform values every time they are bound, see `ParamsBinding`),
 /// and GPUs get the blocks as uniform buffers still.
 #[test]
 fn software_adapters_get_no_uniform_buffers() {
-    for pass in igi_gpu::passes::SOURCES {
+    for pass in SOURCES {
         let uniforms = |binding| {
             let module = naga::front::wgsl::parse_str(&compose_for(pass, binding)).unwrap();
             module
@@ -77,7 +120,7 @@ fn software_adapters_get_no_uniform_buffers() {
 #[test]
 fn storage_buffers_per_stage_is_what_the_shaders_declare() {
     for binding in ParamsBinding::ALL {
-        let most = igi_gpu::passes::SOURCES
+        let most = SOURCES
             .iter()
             .map(|pass| {
                 let module = naga::front::wgsl::parse_str(&compose_for(pass, binding)).unwrap();

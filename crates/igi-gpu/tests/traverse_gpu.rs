@@ -15,16 +15,16 @@ use igi_core::bvh::{
     brute_force_any, brute_force_closest, offset_ray_origin, Bvh, BvhBuilder, Hit, NO_HIT,
 };
 use igi_gpu::context::{AdapterChoice, GpuContext};
+use igi_gpu::shader::ParamsBinding;
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 use wgpu::util::DeviceExt;
 
-const SCENE: &str = include_str!("../src/shaders/scene.wgsl");
-const TRAVERSE: &str = include_str!("../src/shaders/traverse.wgsl");
-
 /// Traces each ray for closest and any hit and as a segment, and offsets its origin along
 /// its normal.
 const KERNEL: &str = r#"
+#import traverse
+
 struct TestRay {
     origin: vec3<f32>, tmax: f32,
     dir: vec3<f32>, _pad0: f32,
@@ -353,7 +353,8 @@ fn on_triangle(tri: &[Vec3; 3], o: Vec3, d: Vec3, h: &Hit) -> bool {
 
 fn run_kernel(ctx: &GpuContext, bvh: &Bvh, rays: &[(TestRay, Kind)]) -> Vec<TestResult> {
     let device = &ctx.device;
-    let src = [SCENE, TRAVERSE, KERNEL].join("\n");
+    let src = igi_gpu::shader::try_compose("traverse test", KERNEL, ParamsBinding::Uniform)
+        .expect("traverse.wgsl and its imports resolve");
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some("traverse test"),
         source: wgpu::ShaderSource::Wgsl(src.into()),

@@ -5,6 +5,7 @@
 mod common;
 
 use common::wgsl_constant;
+use igi_gpu::shader::ParamsBinding;
 use naga::valid::{Capabilities, ValidationFlags, Validator};
 
 const SCENE: &str = include_str!("../src/shaders/scene.wgsl");
@@ -12,6 +13,8 @@ const TRAVERSE: &str = include_str!("../src/shaders/traverse.wgsl");
 
 /// A kernel that calls every public function of traverse.wgsl.
 const KERNEL: &str = r#"
+#import traverse
+
 @group(1) @binding(0) var<storage, read_write> out: array<vec4<f32>>;
 
 @compute @workgroup_size(64)
@@ -39,8 +42,10 @@ fn parse_and_validate(src: &str) -> naga::Module {
     module
 }
 
+/// The kernel after traverse.wgsl and what it imports (scene.wgsl), as every tracing pass
+/// composes them.
 fn composed() -> String {
-    [SCENE, TRAVERSE, KERNEL].join("\n")
+    igi_gpu::shader::try_compose("kernel", KERNEL, ParamsBinding::Uniform).unwrap()
 }
 
 #[test]
@@ -50,8 +55,15 @@ fn traverse_wgsl_validates() {
 
 #[test]
 fn traverse_wgsl_matches_the_shared_module() {
-    // The shader assembly of igi-gpu composes the same file.
-    assert_eq!(igi_gpu::shader::TRAVERSE, TRAVERSE);
+    // The shader assembly of igi-gpu composes the same files, and traverse.wgsl needs
+    // scene.wgsl alone.
+    assert_eq!(igi_gpu::shader::module("traverse"), Some(TRAVERSE));
+    assert_eq!(igi_gpu::shader::module("scene"), Some(SCENE));
+    assert_eq!(
+        igi_gpu::shader::resolve::imports("traverse", TRAVERSE),
+        Ok(vec!["scene"])
+    );
+    assert!(composed().starts_with(SCENE));
 }
 
 #[test]

@@ -13,84 +13,8 @@ use crate::profiler::Profiler;
 use crate::scene_buffers::{buffer_entry, UNIFORM};
 use crate::shader::ParamsBinding;
 
-/// A pass's own WGSL, whether it gathers from VPLs (then it declares `vpls` and
-/// `vpl_header`, and `gather.wgsl` is composed in) and whether it upsamples (then it
-/// declares the G-buffer's position and normal and `low_irradiance`, and `upsample.wgsl`
-/// is composed in).
-pub struct PassSource {
-    pub name: &'static str,
-    pub wgsl: &'static str,
-    pub gathers: bool,
-    /// Whether it is composed with upsample.wgsl (joint bilateral upsampling).
-    pub upsamples: bool,
-    /// Whether it uses subgroup operations (built only where the device has
-    /// `Features::SUBGROUP`; validated with naga's subgroup capability).
-    pub subgroups: bool,
-}
-
-/// Each pass's own WGSL, by name (composed with the shared modules by `shader::compose`).
-pub const SOURCES: &[PassSource] = &[
-    PassSource {
-        name: "vpl",
-        wgsl: include_str!("vpl/vpl.wgsl"),
-        gathers: false,
-        upsamples: false,
-        subgroups: false,
-    },
-    PassSource {
-        name: "direct",
-        wgsl: include_str!("direct/direct.wgsl"),
-        gathers: true,
-        upsamples: false,
-        subgroups: false,
-    },
-    PassSource {
-        name: "indirect",
-        wgsl: include_str!("indirect/indirect.wgsl"),
-        gathers: true,
-        upsamples: false,
-        subgroups: false,
-    },
-    PassSource {
-        name: "filter",
-        wgsl: include_str!("filter/filter.wgsl"),
-        gathers: false,
-        upsamples: true,
-        subgroups: false,
-    },
-    PassSource {
-        name: "rays",
-        wgsl: include_str!("../raybench/rays.wgsl"),
-        gathers: false,
-        upsamples: false,
-        subgroups: false,
-    },
-    PassSource {
-        name: "rays_refill",
-        // rays.wgsl's bindings and kernels, then the refill schedule's.
-        wgsl: concat!(
-            include_str!("../raybench/rays.wgsl"),
-            include_str!("../raybench/rays_refill.wgsl")
-        ),
-        gathers: false,
-        upsamples: false,
-        subgroups: true,
-    },
-    PassSource {
-        name: "compose",
-        wgsl: include_str!("compose/compose.wgsl"),
-        gathers: false,
-        upsamples: true,
-        subgroups: false,
-    },
-    PassSource {
-        name: "display",
-        wgsl: include_str!("display/display.wgsl"),
-        gathers: false,
-        upsamples: false,
-        subgroups: false,
-    },
-];
+/// The passes' WGSL sources, kept by the shader module with the modules they import.
+pub use crate::shader::{PassSource, SOURCES};
 
 /// The two builds of a gathering pass: VPL shadow rays against triangles, or against
 /// the triangles' bounding boxes (imperfect visibility, paper section 4.1). One pipeline

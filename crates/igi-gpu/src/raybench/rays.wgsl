@@ -1,6 +1,10 @@
 // rays.wgsl: the ray-tracing layer alone (`igi bench rays`): one thread per ray of a ray
 // file (igi_core::rays: origin, tmin, direction, tmax), any-hit or closest-hit.
 
+// params: binding 0 of group 1, as in every pass's layout (unused here).
+#import params
+#import traverse
+
 @group(1) @binding(1) var<storage, read> rays: array<vec4<f32>>;
 // any: 1 occluded / 0 free per ray; closest: (triangle slot or NO_HIT, bits of t) per ray.
 @group(1) @binding(2) var<storage, read_write> results: array<u32>;
@@ -12,9 +16,8 @@ fn ray_index(gid: vec3<u32>, groups: vec3<u32>) -> u32 {
 }
 
 // One walk with a stack of its own. The stack is declared in these functions rather than
-// in the entry points: declared in the entry point, the very same walks ran 9% slower on
-// the H200 (frame rays 5.62 -> 5.12 G rays/s, random segments 2.13 -> 2.06; the driver
-// shows nothing that differs, docs/PERFORMANCE.md attempt 89).
+// in the entry points: declared in the entry point, the very same walks ran slower on
+// NVIDIA's driver, for no reason its tools show.
 fn ray_any_hit(origin: vec3<f32>, dir: vec3<f32>, tmax: f32) -> bool {
     var stack: WalkStack;
     return trace_any(&stack, origin, dir, tmax);

@@ -1,6 +1,6 @@
-// rays_refill.wgsl: the any-hit query over a ray file for incoherent batches, composed
-// after rays.wgsl (`RaySchedule::Refill` of raybench.rs). Aila and Laine's persistent
-// threads with dynamic ray fetch ("Understanding the Efficiency of Ray Traversal on
+// rays_refill.wgsl: the any-hit query over a ray file for incoherent batches, with the
+// bindings and kernels of rays.wgsl (`RaySchedule::Refill` of raybench.rs). Aila and
+// Laine's persistent threads with dynamic ray fetch ("Understanding the Efficiency of Ray Traversal on
 // GPUs", 2009): a lane walks one node per loop iteration, and once enough lanes of its
 // subgroup have finished their rays, each idle lane takes the next ray of the batch from
 // a counter. With one ray per thread (any_hit), a warp of random segments runs as long as
@@ -20,6 +20,10 @@
 // 90). Coherent batches (neighbouring rays walk alike, as the renderer's VPL-major
 // shadow rays do) trace faster with one ray per thread: a refilled lane walks apart from
 // the lanes still on their old rays (the frame set 6.27 -> 5.48 G rays/s, attempt 110).
+
+#import scene
+#import traverse
+#import rays
 
 // The next unassigned ray of the batch; zeroed before each dispatch.
 @group(1) @binding(3) var<storage, read_write> ray_counter: atomic<u32>;

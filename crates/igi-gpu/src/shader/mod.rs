@@ -1,34 +1,122 @@
-//! Shader assembly: every pass's WGSL is the shared modules (scene bindings, traversal,
-//! frame types and sampling, VPL gathering, upsampling) followed by the pass's own file. Composition is
-//! plain concatenation in a fixed order, done once at pipeline creation; a naga test
-//! parses and validates every composed shader, so a broken shader fails a test, not a user.
-
-use crate::passes::PassSource;
+//! Shader assembly: each pass's WGSL file names the shared modules it uses on `#import`
+//! lines at its top, and each module names its own; [`resolve`] puts every module a pass
+//! needs before it, each once, its imports before it. Done once at pipeline creation; a
+//! naga test parses and validates every composed shader and every module on its own, so a
+//! broken shader, or a module that relies on what its includer declares, fails a test, not
+//! a user.
 
 pub mod resolve;
 
-/// Shared WGSL modules, in the order they are prepended.
-pub const SCENE: &str = include_str!("../shaders/scene.wgsl");
-pub const TRAVERSE: &str = include_str!("../shaders/traverse.wgsl");
-pub const FRAME: &str = include_str!("../shaders/frame.wgsl");
-pub const GATHER: &str = include_str!("../shaders/gather.wgsl");
-pub const UPSAMPLE: &str = include_str!("../shaders/upsample.wgsl");
+pub use resolve::ResolveError;
 
-/// A pass's full shader: the shared modules, then the pass, its parameter blocks bound as
-/// uniform buffers (as written).
+/// Every WGSL module a shader may `#import`, by name. Shared modules live in `shaders/`,
+/// a pass's own file in its pass's folder.
+pub const MODULES: &[(&str, &str)] = &[
+    ("scene", include_str!("../shaders/scene.wgsl")),
+    ("traverse", include_str!("../shaders/traverse.wgsl")),
+    ("params", include_str!("../shaders/params.wgsl")),
+    ("constants", include_str!("../shaders/constants.wgsl")),
+    ("sampling", include_str!("../shaders/sampling.wgsl")),
+    ("surface", include_str!("../shaders/surface.wgsl")),
+    ("ray_count", include_str!("../shaders/ray_count.wgsl")),
+    ("vpl_record", include_str!("../shaders/vpl_record.wgsl")),
+    (
+        "geometry_term",
+        include_str!("../shaders/geometry_term.wgsl"),
+    ),
+    ("gbuffer", include_str!("../shaders/gbuffer.wgsl")),
+    ("mirror_list", include_str!("../shaders/mirror_list.wgsl")),
+    ("gather", include_str!("../shaders/gather.wgsl")),
+    ("upsample", include_str!("../shaders/upsample.wgsl")),
+    // The ray bench's any-hit and closest-hit kernels, which its refill schedule extends.
+    ("rays", include_str!("../raybench/rays.wgsl")),
+];
+
+/// The source of module `name`, if [`MODULES`] has one.
+pub fn module(name: &str) -> Option<&'static str> {
+    MODULES.iter().find(|(n, _)| *n == name).map(|(_, s)| *s)
+}
+
+/// A pass's own WGSL (its `#import` lines name the modules composed before it).
+pub struct PassSource {
+    pub name: &'static str,
+    pub wgsl: &'static str,
+    /// Whether it uses subgroup operations (built only where the device has
+    /// `Features::SUBGROUP`; validated with naga's subgroup capability).
+    pub subgroups: bool,
+}
+
+/// Each pass's own WGSL, by name (composed with the modules it imports by [`compose`]).
+pub const SOURCES: &[PassSource] = &[
+    PassSource {
+        name: "vpl",
+        wgsl: include_str!("../passes/vpl/vpl.wgsl"),
+        subgroups: false,
+    },
+    PassSource {
+        name: "direct",
+        wgsl: include_str!("../passes/direct/direct.wgsl"),
+        subgroups: false,
+    },
+    PassSource {
+        name: "indirect",
+        wgsl: include_str!("../passes/indirect/indirect.wgsl"),
+        subgroups: false,
+    },
+    PassSource {
+        name: "filter",
+        wgsl: include_str!("../passes/filter/filter.wgsl"),
+        subgroups: false,
+    },
+    PassSource {
+        name: "rays",
+        wgsl: include_str!("../raybench/rays.wgsl"),
+        subgroups: false,
+    },
+    PassSource {
+        name: "rays_refill",
+        // Imports rays.wgsl: its bindings and kernels, then the refill schedule's.
+        wgsl: include_str!("../raybench/rays_refill.wgsl"),
+        subgroups: true,
+    },
+    PassSource {
+        name: "compose",
+        wgsl: include_str!("../passes/compose/compose.wgsl"),
+        subgroups: false,
+    },
+    PassSource {
+        name: "display",
+        wgsl: include_str!("../passes/display/display.wgsl"),
+        subgroups: false,
+    },
+];
+
+/// A pass's full shader: the modules it imports, then the pass, its parameter blocks bound
+/// as uniform buffers (as written).
 pub fn compose(pass: &PassSource) -> String {
     compose_for(pass, ParamsBinding::Uniform)
 }
 
 /// A pass's full shader with its parameter blocks bound as `params` says.
+///
+/// Panics if the imports do not resolve: the sources are fixed when igi is built, and
+/// `every_pass_shader_validates` composes each of them.
 pub fn compose_for(pass: &PassSource, params: ParamsBinding) -> String {
-    let gather = if pass.gathers { GATHER } else { "" };
-    let upsample = if pass.upsamples { UPSAMPLE } else { "" };
-    let wgsl = [SCENE, TRAVERSE, FRAME, gather, upsample, pass.wgsl].join("\n");
-    match params {
+    try_compose(pass.name, pass.wgsl, params).unwrap_or_else(|e| panic!("{}: {e}", pass.name))
+}
+
+/// WGSL `source` (called `name` in errors) after the modules it imports, its parameter
+/// blocks bound as `params` says.
+pub fn try_compose(
+    name: &str,
+    source: &str,
+    params: ParamsBinding,
+) -> Result<String, ResolveError> {
+    let wgsl = resolve::resolve(name, source, module)?;
+    Ok(match params {
         ParamsBinding::Uniform => wgsl,
         ParamsBinding::Storage => wgsl.replace(UNIFORM_DECLARATION, "var<storage, read>"),
-    }
+    })
 }
 
 /// How the shaders' parameter blocks (the frame's `params`, the gathers' VPL range, the
@@ -40,7 +128,7 @@ pub fn compose_for(pass: &PassSource, params: ParamsBinding) -> String {
 /// is bound when the shader's branches or loops depend on uniform values alone (it
 /// inlines them), and keeps every copy until the pipeline is dropped. That made each
 /// frame compile shaders again, 3-4x its time, and grow the process by about 1.35 MB:
-/// 3.9 GB after 3,000 accumulated frames (docs/PERFORMANCE.md attempt 123).
+/// 3.9 GB after 3,000 accumulated frames.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ParamsBinding {
     Uniform,
@@ -90,7 +178,7 @@ impl ParamsBinding {
 /// blocks), for the layout and constant tests; `every_pass_shader_validates` goes through
 /// both bindings itself.
 pub fn all_shaders() -> Vec<(&'static str, String)> {
-    crate::passes::SOURCES
+    SOURCES
         .iter()
         .map(|pass| (pass.name, compose(pass)))
         .collect()

@@ -50,14 +50,20 @@ pub fn imports<'a>(name: &str, source: &'a str) -> Result<Vec<&'a str>, ResolveE
         if let Some(rest) = line.strip_prefix(IMPORT) {
             let module = name.to_string();
             if code {
-                return Err(ResolveError::ImportAfterCode { module, line: i + 1 });
+                return Err(ResolveError::ImportAfterCode {
+                    module,
+                    line: i + 1,
+                });
             }
             let mut words = rest.split_whitespace();
             match (words.next(), words.next()) {
-                (Some(import), None) if rest.starts_with(char::is_whitespace) => {
-                    found.push(import)
+                (Some(import), None) if rest.starts_with(char::is_whitespace) => found.push(import),
+                _ => {
+                    return Err(ResolveError::MalformedImport {
+                        module,
+                        line: i + 1,
+                    })
                 }
-                _ => return Err(ResolveError::MalformedImport { module, line: i + 1 }),
             }
         } else if !line.is_empty() && !line.starts_with("//") {
             code = true;
@@ -139,7 +145,12 @@ mod tests {
             ("b", "#import a\nconst B = A;"),
             ("c", "#import a\n#import b\nconst C = B;"),
         ];
-        let out = resolve("root", "#import c\n#import b\nconst R = C;", table(&modules)).unwrap();
+        let out = resolve(
+            "root",
+            "#import c\n#import b\nconst R = C;",
+            table(&modules),
+        )
+        .unwrap();
         assert_eq!(
             out,
             "// a\nconst A = 1;\n\nconst B = A;\n\nconst C = B;\n\nconst R = C;\n"
@@ -151,7 +162,10 @@ mod tests {
         let modules = [("a", "const A = 1;")];
         let root = "// root: what it does\n\n  #import a\n// more\nconst R = A;";
         let out = resolve("root", root, table(&modules)).unwrap();
-        assert_eq!(out, "const A = 1;\n\n// root: what it does\n\n// more\nconst R = A;\n");
+        assert_eq!(
+            out,
+            "const A = 1;\n\n// root: what it does\n\n// more\nconst R = A;\n"
+        );
     }
 
     #[test]
@@ -180,7 +194,10 @@ mod tests {
             ("c", "#import a\nconst C = 1;"),
         ];
         let err = resolve("root", "#import a", table(&modules)).unwrap_err();
-        assert_eq!(err, ResolveError::Cycle(vec!["a".into(), "b".into(), "c".into()]));
+        assert_eq!(
+            err,
+            ResolveError::Cycle(vec!["a".into(), "b".into(), "c".into()])
+        );
         assert_eq!(err.to_string(), "import cycle: a -> b -> c -> a");
         // A module importing itself, and the root imported back.
         let modules = [("s", "#import s")];
@@ -199,7 +216,11 @@ mod tests {
     fn an_import_after_code_is_an_error() {
         let modules = [("a", "const A = 1;"), ("b", "const B = 1;\n#import a")];
         assert_eq!(
-            resolve("root", "#import a\nconst R = 1;\n\n#import b", table(&modules)),
+            resolve(
+                "root",
+                "#import a\nconst R = 1;\n\n#import b",
+                table(&modules)
+            ),
             Err(ResolveError::ImportAfterCode {
                 module: "root".into(),
                 line: 4
@@ -226,6 +247,12 @@ mod tests {
                 "{bad}"
             );
         }
-        assert_eq!(imports("root", "#import a // why"), Err(ResolveError::MalformedImport { module: "root".into(), line: 1 }));
+        assert_eq!(
+            imports("root", "#import a // why"),
+            Err(ResolveError::MalformedImport {
+                module: "root".into(),
+                line: 1
+            })
+        );
     }
 }

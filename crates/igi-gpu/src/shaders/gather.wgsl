@@ -1,7 +1,7 @@
 // gather.wgsl: the incident indirect term from VPLs at a surface point (paper section 4,
 // "indirect illumination"): E(x) = sum_k Phi_k (rho_k / pi) V(x, y_k) G(x, y_k), with the
-// bounded G of frame.wgsl. Uses the globals `vpls` and `vpl_header`, which every pass
-// that includes this module declares.
+// bounded G of geometry_term.wgsl. Both gathering passes (direct and indirect) bind the
+// VPL list at bindings 1 and 2 of group 1, declared here.
 //
 // A gathering pass may be dispatched several times, each over one range of the VPL list
 // (bind group 2, a dynamic offset per dispatch), adding to what earlier ranges left.
@@ -9,6 +9,17 @@
 // llvmpipe stops a shader invocation after 65535 loop iterations in all (its
 // LP_MAX_TGSI_LOOP_ITERATIONS, shared by every loop of the shader), and one VPL costs a
 // whole BVH traversal.
+
+#import constants
+#import params
+#import traverse
+#import sampling
+#import geometry_term
+#import ray_count
+#import vpl_record
+
+@group(1) @binding(1) var<storage, read> vpls: array<Vpl>;
+@group(1) @binding(2) var<storage, read> vpl_header: VplHeader;
 
 // Imperfect visibility (paper section 4.1): VPL shadow rays test the triangles' bounding
 // boxes instead of the triangles. Set per pipeline (passes::GatherPipelines).
@@ -47,8 +58,8 @@ fn interleave_subset(x: u32, y: u32) -> u32 {
 // The irregular pattern's subset at place `local` of pixel (x, y)'s tile: a seeded
 // Fisher-Yates permutation of the tile's places. A function of its own, so that its
 // permutation array (zeroed where it is declared, as every WGSL variable) costs only the
-// irregular pattern: zeroed in interleave_subset, it took 1.5-2% of iv+ds+il frames with
-// the regular one (docs/PERFORMANCE.md attempt 89).
+// irregular pattern: zeroed in interleave_subset, it slowed interleaved frames with the
+// regular one too.
 fn irregular_subset(x: u32, y: u32, local: u32) -> u32 {
     let n = params.interleave_n;
     let m = params.interleave_m;
@@ -66,15 +77,6 @@ fn irregular_subset(x: u32, y: u32, local: u32) -> u32 {
         perm[j] = t;
     }
     return perm[local];
-}
-
-// Room for the pixels of one interleaving subset in the list of mirrored pixels
-// (direct.wgsl's mirror_list): every n x m tile of the full-resolution image, partial
-// ones at the edges included, holds one pixel of each subset.
-fn mirror_bucket_size() -> u32 {
-    let n = params.interleave_n;
-    let m = params.interleave_m;
-    return ((params.width + n - 1u) / n) * ((params.height + m - 1u) / m);
 }
 
 // E at surface point p from the interleaving subset of pixel (x, y) of the image being
@@ -120,8 +122,8 @@ fn vpl_irradiance(stack: ptr<function, WalkStack>, p: vec3<f32>, ng: vec3<f32>, 
         }
         let end = offset_ray_origin(vpl.position, vpl.normal, params.ray_offset_floor);
         // The same origin for every VPL, computed again for each rather than held over
-        // the loop: three registers fewer across the walk, and canonical frames 0.6%
-        // faster on the H200 (docs/PERFORMANCE.md attempt 81).
+        // the loop: three registers fewer across the walk, which made canonical frames
+        // faster.
         let origin = offset_ray_origin(p, ng, params.ray_offset_floor);
         traced += 1u;
         if (trace_segment(stack, origin, end - origin, IMPERFECT_VISIBILITY)) {

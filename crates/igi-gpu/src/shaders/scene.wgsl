@@ -37,6 +37,6 @@ struct PointLight {
 @group(0) @binding(2) var<storage, read> tri_shading: array<TriShading>;
 @group(0) @binding(3) var<storage, read> materials: array<Material>;
 @group(0) @binding(4) var<storage, read> lights: array<PointLight>;
-// Rays traced per kind (frame.wgsl's RAY_* indices), counted only when
+// Rays traced per kind (ray_count.wgsl's RAY_* indices), counted only when
 // params.count_rays is set: one atomic add per invocation and kind, in an untimed frame.
 @group(0) @binding(5) var<storage, read_write> ray_counters: array<atomic<u32>, 8>;

@@ -4,13 +4,15 @@
 // ray-triangle test (Woop, Benthin, Wald, JCGT 2013), the robust slab test (Ize, JCGT
 // 2013) and the ray origin offset of Wächter and Binder (Ray Tracing Gems, ch. 6).
 //
-// Composed after scene.wgsl. CPU twin: crates/igi-core/src/bvh/traverse.rs, the same
-// algorithm in the same order; the reasons behind each choice are written there. Change
-// both together: crates/igi-gpu/tests/traverse_gpu.rs compares them ray by ray.
+// CPU twin: crates/igi-core/src/bvh/traverse.rs, the same algorithm in the same order;
+// the reasons behind each choice are written there. Change both together:
+// crates/igi-gpu/tests/traverse_gpu.rs compares them ray by ray.
 //
 // Results can differ from the CPU only by rounding: WGSL allows division to be 2.5 ulp,
 // and GPU compilers may fuse a * b + c into one fma. Neither can break watertightness:
 // the inside test compares rounded products and never looks at a fused difference.
+
+#import scene
 
 // Hit.tri of a miss.
 const NO_HIT: u32 = 0xffffffffu;

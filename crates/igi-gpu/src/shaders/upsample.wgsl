@@ -2,11 +2,24 @@
 // resolution (paper section 4.2), S(p) = 1/k sum_q I_q f(|p - q|) w(N_p . N_q) [x depth
 // weight], f a spatial Gaussian over the 4 x 4 low-resolution neighbours, w the paper's
 // cosine (to a power, 1 by default), and what it shares with the fused filter
-// (filter.wgsl). compose.wgsl upsamples as it writes each pixel: a pass of its own cost
-// 0.015 ms more at 800 x 600 and 0.045 ms more at 1920 x 1080 on the H200
-// (docs/PERFORMANCE.md attempt 52).
-// Composed after frame.wgsl into the passes that declare `gbuf_position`, `gbuf_normal`
-// and `fn low_irradiance(i: u32) -> vec3<f32>` (E of low-resolution pixel i).
+// (filter.wgsl). compose.wgsl upsamples as it writes each pixel, which was faster than a
+// pass of its own.
+// Both passes that upsample (filter and compose) bind the G-buffer's shading normal and
+// the low-resolution E at bindings 2 and 3 of group 1, declared here (binding 1 is the
+// G-buffer's position in both).
+
+#import params
+#import gbuffer
+
+@group(1) @binding(2) var<storage, read> gbuf_normal: array<vec4<f32>>;
+// E at the indirect term's resolution (low_width x low_height), or at full resolution
+// where compose's `main` reads it without upsampling.
+@group(1) @binding(3) var<storage, read> irradiance_in: array<vec4<f32>>;
+
+// E of low-resolution pixel i.
+fn low_irradiance(i: u32) -> vec3<f32> {
+    return irradiance_in[i].xyz;
+}
 
 // Low-resolution coordinate of full-resolution pixel p's centre, in the frame where
 // low-res pixel c sits at its representative pixel's centre.
@@ -16,23 +29,22 @@ fn low_coordinate(p: u32) -> f32 {
 }
 
 // Whether the primary ray of pixel q hit a surface, from the G-buffer's shading normal
-// alone: its w is the hit's distance, positive (traverse.wgsl takes hits at t > 0), and
-// the direct pass clears it to 0 every frame. (Reading the position's w as well cost
-// every tap of the upsampler a second scattered read.)
-fn has_surface(q: u32) -> bool {
-    return gbuf_normal[q].w > 0.0;
+// alone (gbuffer.wgsl): reading the position as well would cost every tap of the
+// upsampler a second scattered read.
+fn sample_has_surface(q: u32) -> bool {
+    return normal_has_surface(gbuf_normal[q]);
 }
 
 // Range weight of the upsampler between full-resolution pixel p and sample q.
 fn range_weight(p: u32, q: u32) -> f32 {
     let nq = gbuf_normal[q];
-    if (nq.w <= 0.0) {
+    if (!normal_has_surface(nq)) {
         return 0.0;
     }
     let np = gbuf_normal[p];
     var w = pow(max(dot(np.xyz, nq.xyz), 0.0), params.normal_power);
     if (params.upsample_depth != 0u) {
-        let d = (np.w - nq.w) / (params.depth_threshold * np.w);
+        let d = (normal_depth(np) - normal_depth(nq)) / (params.depth_threshold * normal_depth(np));
         w *= exp(-0.5 * d * d);
     }
     return w;
@@ -59,7 +71,7 @@ fn gather_sample(g: ptr<function, Gathered>, x: i32, y: i32, w: f32, d2: f32) {
     let value = low_irradiance(u32(y) * params.low_width + u32(x));
     (*g).sum += w * value;
     (*g).weight += w;
-    if (has_surface(q) && d2 < (*g).nearest_d2) {
+    if (sample_has_surface(q) && d2 < (*g).nearest_d2) {
         (*g).nearest_d2 = d2;
         (*g).nearest = value;
     }

@@ -7,22 +7,23 @@
 // pass's output, or the fused filter's); `main_upsampled` upsamples it from the indirect
 // term's resolution (`irradiance_in` then holds the indirect pass's or the discontinuity
 // buffer's output) with the joint bilateral upsampler of upsample.wgsl.
+// Bindings 2 and 3 of group 1 (the G-buffer's shading normal and E, irradiance_in) are
+// upsample.wgsl's, at the numbers the filter binds them at too.
 
-@group(1) @binding(1) var<storage, read> direct_in: array<vec4<f32>>;
-@group(1) @binding(2) var<storage, read> gbuf_albedo: array<vec4<f32>>;
-@group(1) @binding(3) var<storage, read> irradiance_in: array<vec4<f32>>;
+#import constants
+#import params
+#import gbuffer
+#import upsample
+
+@group(1) @binding(1) var<storage, read> gbuf_position: array<vec4<f32>>;
 @group(1) @binding(4) var<storage, read_write> color_out: array<vec4<f32>>;
-@group(1) @binding(5) var<storage, read> gbuf_position: array<vec4<f32>>;
-@group(1) @binding(6) var<storage, read> gbuf_normal: array<vec4<f32>>;
-// Indirect light at the pixel's mirrored hit (indirect.wgsl over the mirror record): weight (w = 1 where there is
-// one) times E there, after the mirror discontinuity filter when interleaved.
+@group(1) @binding(5) var<storage, read> direct_in: array<vec4<f32>>;
+@group(1) @binding(6) var<storage, read> gbuf_albedo: array<vec4<f32>>;
+// Indirect light at the pixel's mirrored hit (indirect.wgsl over the mirror record): the
+// mirror record's weight (gbuffer.wgsl) times E there, after the mirror discontinuity
+// filter when interleaved.
 @group(1) @binding(7) var<storage, read> mirror_weight: array<vec4<f32>>;
 @group(1) @binding(8) var<storage, read> mirror_irradiance: array<vec4<f32>>;
-
-// The low-resolution E that main_upsampled gathers from (upsample.wgsl).
-fn low_irradiance(i: u32) -> vec3<f32> {
-    return irradiance_in[i].xyz;
-}
 
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
@@ -40,7 +41,7 @@ fn main_upsampled(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let pixel = gid.y * params.width + gid.x;
     var e = vec3<f32>(0.0);
-    if (gbuf_position[pixel].w > 0.0) {
+    if (has_surface(gbuf_position[pixel])) {
         e = upsampled_irradiance(gid.x, gid.y, pixel);
     }
     compose_pixel(pixel, e);
@@ -50,13 +51,12 @@ fn main_upsampled(@builtin(global_invocation_id) gid: vec3<u32>) {
 fn compose_pixel(pixel: u32, e: vec3<f32>) {
     var direct = direct_in[pixel].xyz;
     let mirrored = mirror_weight[pixel];
-    if (mirrored.w > 0.0) {
+    if (has_weight(mirrored)) {
         direct += mirrored.xyz * mirror_irradiance[pixel].xyz;
     }
     let indirect = gbuf_albedo[pixel].xyz / PI * e;
     var c = direct + indirect;
-    // position.w > 0 where the primary ray hit a surface.
-    let hit = gbuf_position[pixel].w > 0.0;
+    let hit = has_surface(gbuf_position[pixel]);
     switch params.output {
         case 1u: { c = direct; }
         case 2u: { c = indirect; }

@@ -8,42 +8,48 @@
 // The pass walks twice. Its first walk (`main`) gathers no VPLs, so that it can run
 // beside VPL shooting, before any VPL exists (frame.rs: the two are not kept apart by a
 // barrier); it does everything else and lists the pixels whose chain has hits seen in a
-// mirror seen in a mirror. Later walks (`chains_main`,
-// after VPL shooting, dispatched over that list) follow only those chains again and add
-// the VPL light of their range (one range on GPUs, several on llvmpipe, see gather.wgsl)
-// at those hits.
+// mirror seen in a mirror. Later walks (`chains_main`, after VPL shooting, over that
+// list) follow only those chains again and add the VPL light of their range (one range
+// on GPUs, several on llvmpipe, see gather.wgsl) at those hits.
+// Bindings 1 and 2 of group 1 (the VPL list) are gather.wgsl's.
 
-@group(1) @binding(1) var<storage, read> vpls: array<Vpl>;
-@group(1) @binding(2) var<storage, read> vpl_header: VplHeader;
+#import constants
+#import params
+#import scene
+#import traverse
+#import surface
+#import ray_count
+#import gbuffer
+#import mirror_list
+#import gather
+
 @group(1) @binding(3) var<storage, read_write> direct_out: array<vec4<f32>>;
-// G-buffer: position (w = 1 where a surface was hit), shading normal, geometric normal,
-// diffuse albedo.
+// G-buffer of the primary hits (gbuffer.wgsl says what each record holds).
 @group(1) @binding(4) var<storage, read_write> gbuf_position: array<vec4<f32>>;
 @group(1) @binding(5) var<storage, read_write> gbuf_normal: array<vec4<f32>>;
 @group(1) @binding(6) var<storage, read_write> gbuf_geometric: array<vec4<f32>>;
 @group(1) @binding(7) var<storage, read_write> gbuf_albedo: array<vec4<f32>>;
 // The first diffuse hit of the pixel's mirror chain, for the mirror indirect stage
-// (indirect.wgsl) to gather at. The shading normal's w is the chain's length (the
-// depth the mirror discontinuity buffer compares), the weight's w is 1 where there is one.
+// (indirect.wgsl) to gather at (gbuffer.wgsl's mirror record).
 @group(1) @binding(8) var<storage, read_write> mirror_position: array<vec4<f32>>;
 @group(1) @binding(9) var<storage, read_write> mirror_normal: array<vec4<f32>>;
 @group(1) @binding(10) var<storage, read_write> mirror_geometric: array<vec4<f32>>;
 @group(1) @binding(11) var<storage, read_write> mirror_weight: array<vec4<f32>>;
 // The pixels that have such a hit, for the mirror indirect stage to gather at only them,
-// in one bucket per interleaving subset (see mirror_bucket in gather.wgsl): [s] counts
-// the pixels appended to bucket s (zeroed before each frame by frame.rs), bucket s
-// starts at MAX_SUBSETS + s mirror_bucket_size().
+// in one bucket per interleaving subset (mirror_list.wgsl says where each bucket lies):
+// [s] counts the pixels appended to bucket s (zeroed before each frame by frame.rs).
 @group(1) @binding(12) var<storage, read_write> mirror_list: array<atomic<u32>>;
 // The pixels whose chain has hits seen in a mirror seen in a mirror, for the later walks:
 // [0] counts those the first walk appended (zeroed before each frame by frame.rs), the
 // pixels follow from [1] on. (A dispatch over the whole image that skipped the others
-// took 0.018 ms of the H200 in the conference room, which has none: docs/PERFORMANCE.md
-// attempt 50.)
+// cost time even in scenes that have none.)
 @group(1) @binding(13) var<storage, read_write> chain_list: array<atomic<u32>>;
 
-// The first walk: one thread per pixel, 8 x 4 pixels (one warp) per workgroup: 8 x 8 took
-// 0.74 ms against 0.66 ms on the H200 (conference room, 800 x 600; docs/PERFORMANCE.md
-// attempt 32).
+// Listed pixels per workgroup of the later walks (chains_main).
+const CHAIN_GROUP: u32 = 32u;
+
+// The first walk: one thread per pixel, 8 x 4 pixels (one warp) per workgroup, which
+// was faster than 8 x 8.
 @compute @workgroup_size(8, 4)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (gid.x >= params.width || gid.y >= params.height) {
@@ -54,8 +60,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
 
 // The later walks over the listed pixels, one thread each: a fixed grid (frame.rs
 // sizes it by the image, not by the list) strides over the list, so that nothing has to
-// size the dispatch between the first walk and this one (docs/PERFORMANCE.md attempt
-// 75).
+// size the dispatch between the first walk and this one.
 @compute @workgroup_size(CHAIN_GROUP)
 fn chains_main(@builtin(workgroup_id) group: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>, @builtin(local_invocation_index) l: u32) {
     let count = atomicLoad(&chain_list[0]);
@@ -64,6 +69,38 @@ fn chains_main(@builtin(workgroup_id) group: vec3<u32>, @builtin(num_workgroups)
         let pixel = atomicLoad(&chain_list[1u + slot]);
         shade(pixel % params.width, pixel / params.width);
     }
+}
+
+// The primary ray through pixel (x, y); y = 0 is the top row.
+fn camera_ray_dir(x: u32, y: u32) -> vec3<f32> {
+    // Frame 0 of an accumulation looks through pixel centres; later frames jitter
+    // within the pixel, so that accumulation converges to the pixel's box average.
+    let sx = (2.0 * (f32(x) + 0.5 + params.jitter_x) / f32(params.width) - 1.0) * params.tan_half_fov_y * params.aspect;
+    let sy = (1.0 - 2.0 * (f32(y) + 0.5 + params.jitter_y) / f32(params.height)) * params.tan_half_fov_y;
+    return normalize(params.cam_forward + sx * params.cam_right + sy * params.cam_up);
+}
+
+// Irradiance from the point lights at p (shadow rays from the surface to each light).
+fn direct_irradiance(stack: ptr<function, WalkStack>, p: vec3<f32>, ng: vec3<f32>, ns: vec3<f32>) -> vec3<f32> {
+    var e = vec3<f32>(0.0);
+    let origin = offset_ray_origin(p, ng, params.ray_offset_floor);
+    var traced = 0u;
+    for (var l = 0u; l < params.light_count; l += 1u) {
+        let light = lights[l];
+        let d = light.position - p;
+        let dist2 = dot(d, d);
+        let cos_x = dot(ns, d) * inverseSqrt(dist2);
+        if (cos_x <= 0.0 || dot(ng, d) <= 0.0) {
+            continue;
+        }
+        traced += 1u;
+        if (trace_segment(stack, origin, light.position - origin, false)) {
+            continue;
+        }
+        e += light.intensity * cos_x / dist2;
+    }
+    count_rays(RAY_LIGHT_SHADOW, traced);
+    return e;
 }
 
 // Pixel (x, y)'s chain, in the walk `gather_range` says.
@@ -75,12 +112,12 @@ fn shade(x: u32, y: u32) {
     var radiance = vec3<f32>(0.0);
     let first_walk = gather_range.first_walk != 0u;
     if (first_walk) {
-        gbuf_position[pixel] = vec4<f32>(0.0);
-        gbuf_normal[pixel] = vec4<f32>(0.0);
-        gbuf_geometric[pixel] = vec4<f32>(0.0);
-        gbuf_albedo[pixel] = vec4<f32>(0.0);
-        mirror_position[pixel] = vec4<f32>(0.0);
-        mirror_weight[pixel] = vec4<f32>(0.0);
+        gbuf_position[pixel] = empty_record();
+        gbuf_normal[pixel] = empty_record();
+        gbuf_geometric[pixel] = empty_record();
+        gbuf_albedo[pixel] = empty_record();
+        mirror_position[pixel] = empty_record();
+        mirror_weight[pixel] = empty_record();
     } else {
         // Later walks (over the listed pixels only) add VPL light at hits seen in a mirror
         // seen in a mirror.
@@ -102,10 +139,10 @@ fn shade(x: u32, y: u32) {
         let s = surface_at(origin, dir, hit);
         travelled += hit.t;
         if (depth == 0u && first_walk) {
-            gbuf_position[pixel] = vec4<f32>(s.position, 1.0);
-            gbuf_normal[pixel] = vec4<f32>(s.shading_normal, hit.t);
-            gbuf_geometric[pixel] = vec4<f32>(s.geometric_normal, 0.0);
-            gbuf_albedo[pixel] = vec4<f32>(s.diffuse, 0.0);
+            gbuf_position[pixel] = pack_position(s.position);
+            gbuf_normal[pixel] = pack_normal(s.shading_normal, hit.t);
+            gbuf_geometric[pixel] = pack_geometric(s.geometric_normal);
+            gbuf_albedo[pixel] = pack_albedo(s.diffuse);
         }
         if (max(s.diffuse.x, max(s.diffuse.y, s.diffuse.z)) > 0.0) {
             var e = vec3<f32>(0.0);
@@ -119,10 +156,10 @@ fn shade(x: u32, y: u32) {
                     let bucket = interleave_subset(x, y);
                     let slot = atomicAdd(&mirror_list[bucket], 1u);
                     atomicStore(&mirror_list[MAX_SUBSETS + bucket * mirror_bucket_size() + slot], pixel);
-                    mirror_position[pixel] = vec4<f32>(s.position, 1.0);
-                    mirror_normal[pixel] = vec4<f32>(s.shading_normal, travelled);
-                    mirror_geometric[pixel] = vec4<f32>(s.geometric_normal, 0.0);
-                    mirror_weight[pixel] = vec4<f32>(weight, 1.0);
+                    mirror_position[pixel] = pack_position(s.position);
+                    mirror_normal[pixel] = pack_normal(s.shading_normal, travelled);
+                    mirror_geometric[pixel] = pack_geometric(s.geometric_normal);
+                    mirror_weight[pixel] = pack_weight(weight);
                 }
             } else if (depth > 0u) {
                 if (first_walk) {

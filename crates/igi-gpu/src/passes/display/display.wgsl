@@ -5,6 +5,9 @@
 // The render pass's viewport is the image's rectangle in the window (letterboxed), so
 // clip space spans the image; fragment positions are window pixels.
 
+#import params
+#import vpl_record
+
 struct DisplayParams {
     // The image's rectangle in the target: x, y, width, height in target pixels.
     viewport: vec4<f32>,

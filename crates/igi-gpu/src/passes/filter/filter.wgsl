@@ -9,26 +9,29 @@
 //   each sample weighed by its continuity with the full-resolution pixel p itself.
 // Joint bilateral upsampling on its own (section 4.2) happens in compose.wgsl, as it
 // writes each pixel (upsample.wgsl). G-buffer samples of low-resolution pixels are those
-// of their representative pixels.
+// of their representative pixels. Both entry points filter the G-buffer's E, or the
+// mirror record's (gbuffer.wgsl).
+// Bindings 2 and 3 of group 1 (the shading normal and the interleaved E, irradiance_in)
+// are upsample.wgsl's.
+
+#import params
+#import gbuffer
+#import upsample
 
 @group(1) @binding(1) var<storage, read> gbuf_position: array<vec4<f32>>;
-@group(1) @binding(2) var<storage, read> gbuf_normal: array<vec4<f32>>;
-@group(1) @binding(3) var<storage, read> filter_in: array<vec4<f32>>;
 @group(1) @binding(4) var<storage, read_write> filter_out: array<vec4<f32>>;
 
-// The low-resolution E that upsample.wgsl gathers from.
-fn low_irradiance(i: u32) -> vec3<f32> {
-    return filter_in[i].xyz;
-}
+// surface_pixel's answer outside the image or where no surface was hit.
+const NO_PIXEL: u32 = 0xffffffffu;
 
 // Whether full-resolution G-buffer samples a and b lie on one continuous surface.
 fn continuous(a: u32, b: u32) -> bool {
-    if (gbuf_position[b].w <= 0.0) {
+    if (!has_surface(gbuf_position[b])) {
         return false;
     }
     let na = gbuf_normal[a];
     let nb = gbuf_normal[b];
-    let depth_ok = abs(na.w - nb.w) <= params.depth_threshold * na.w;
+    let depth_ok = abs(normal_depth(na) - normal_depth(nb)) <= params.depth_threshold * normal_depth(na);
     return depth_ok && dot(na.xyz, nb.xyz) >= params.normal_threshold;
 }
 
@@ -44,7 +47,7 @@ fn discontinuity(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let low = gid.y * params.low_width + gid.x;
     let centre = representative_pixel(gid.x, gid.y);
-    if (gbuf_position[centre].w <= 0.0) {
+    if (!has_surface(gbuf_position[centre])) {
         filter_out[low] = vec4<f32>(0.0, 0.0, 0.0, 1.0);
         return;
     }
@@ -61,7 +64,7 @@ fn discontinuity(@builtin(global_invocation_id) gid: vec3<u32>) {
             }
             let q = representative_pixel(u32(x), u32(y));
             if (continuous(centre, q)) {
-                sum += filter_in[u32(y) * params.low_width + u32(x)].xyz;
+                sum += irradiance_in[u32(y) * params.low_width + u32(x)].xyz;
                 weight += 1.0;
             }
         }
@@ -70,16 +73,16 @@ fn discontinuity(@builtin(global_invocation_id) gid: vec3<u32>) {
     filter_out[low] = vec4<f32>(sum / max(weight, 1.0), 1.0);
 }
 
-// The full-resolution pixel of `gid`, or NO_HIT outside the image or where no surface
+// The full-resolution pixel of `gid`, or NO_PIXEL outside the image or where no surface
 // was hit (its E is written as zero here).
 fn surface_pixel(gid: vec3<u32>) -> u32 {
     if (gid.x >= params.width || gid.y >= params.height) {
-        return NO_HIT;
+        return NO_PIXEL;
     }
     let pixel = gid.y * params.width + gid.x;
-    if (gbuf_position[pixel].w <= 0.0) {
+    if (!has_surface(gbuf_position[pixel])) {
         filter_out[pixel] = vec4<f32>(0.0, 0.0, 0.0, 1.0);
-        return NO_HIT;
+        return NO_PIXEL;
     }
     return pixel;
 }
@@ -87,7 +90,7 @@ fn surface_pixel(gid: vec3<u32>) -> u32 {
 @compute @workgroup_size(8, 8)
 fn fused(@builtin(global_invocation_id) gid: vec3<u32>) {
     let pixel = surface_pixel(gid);
-    if (pixel == NO_HIT) {
+    if (pixel == NO_PIXEL) {
         return;
     }
     let u = low_coordinate(gid.x);

@@ -10,9 +10,14 @@
 // parameters of full resolution (no downsampling), so that those hits are interleaved
 // too; the discontinuity buffer then runs over that record (filter.wgsl) and compose
 // adds weight x E. The paper gathers every VPL there and leaves the cost as future work.
+// Bindings 1 and 2 of group 1 (the VPL list) are gather.wgsl's.
 
-@group(1) @binding(1) var<storage, read> vpls: array<Vpl>;
-@group(1) @binding(2) var<storage, read> vpl_header: VplHeader;
+#import params
+#import gbuffer
+#import mirror_list
+#import gather
+
+// The G-buffer, or the mirror record (gbuffer.wgsl).
 @group(1) @binding(3) var<storage, read> gbuf_position: array<vec4<f32>>;
 @group(1) @binding(4) var<storage, read> gbuf_normal: array<vec4<f32>>;
 @group(1) @binding(5) var<storage, read> gbuf_geometric: array<vec4<f32>>;
@@ -23,7 +28,7 @@
 fn pixel_sum(x: u32, y: u32, lane: u32, lanes: u32) -> vec3<f32> {
     let pixel = representative_pixel(x, y);
     let position = gbuf_position[pixel];
-    if (position.w <= 0.0) {
+    if (!has_surface(position)) {
         return vec3<f32>(0.0);
     }
     return subset_irradiance(position.xyz, gbuf_geometric[pixel].xyz, gbuf_normal[pixel].xyz, x, y, lane, lanes);
@@ -47,18 +52,17 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
 // pipeline, passes::lanes_for), the threads of a warp on 32 pixels of one interleaving
 // subset and one lane: they trace to the same VPL at each step of the loop (rays that
 // end at one point, from neighbouring pixels of the subset; warps that held the 8 lanes
-// of 4 neighbouring pixels traced to 32 different VPLs, which was up to 1.6x slower,
-// docs/PERFORMANCE.md attempt 27). A workgroup is 32 pixels x COHERENT_LANES lanes: the
-// pixels at the same place of 8 x 4 neighbouring interleaving tiles (the same subset
-// with the regular pattern; the irregular one permutes subsets per tile, which costs
-// coherence, not correctness: attempt 30), and group.z is that place in the tile. The
+// of 4 neighbouring pixels traced to 32 different VPLs, which was up to 1.6x slower).
+// A workgroup is 32 pixels x COHERENT_LANES lanes: the pixels at the same place of
+// 8 x 4 neighbouring interleaving tiles (the same subset with the regular pattern; the
+// irregular one permutes subsets per tile, which costs coherence, not correctness), and
+// group.z is that place in the tile. The
 // lanes' sums are added in lane order.
 override COHERENT_LANES: u32 = 8u;
 // One sum per thread of the workgroup: main_coherent's here, main_list's below. Each
 // entry point has its own array, sized by its own pipeline constant: one array sized for
 // both took 4 KiB of shared memory from every main_coherent workgroup of 128 threads,
-// which needs 2 (shared memory is taken from the L1 cache the walks live in,
-// docs/PERFORMANCE.md attempts 45 and 81).
+// which needs 2 (shared memory is taken from the L1 cache the walks live in).
 var<workgroup> coherent_sums: array<vec4<f32>, 32u * COHERENT_LANES>;
 
 @compute @workgroup_size(32u * COHERENT_LANES)
@@ -106,7 +110,7 @@ var<workgroup> list_sums: array<vec4<f32>, LIST_GROUP>;
 // each step. The lanes' sums are added in lane order. A fixed grid of workgroups per
 // bucket (frame.rs sizes it by the image, not by the list) strides over the bucket's
 // pixels, so that nothing has to size the dispatch between the direct pass, which
-// lists them, and this gather (docs/PERFORMANCE.md attempt 75).
+// lists them, and this gather.
 @compute @workgroup_size(LIST_GROUP)
 fn main_list(@builtin(workgroup_id) group: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>, @builtin(local_invocation_index) l: u32) {
     let per_group = LIST_GROUP / VPL_LANES;

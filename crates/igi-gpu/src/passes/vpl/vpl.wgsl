@@ -7,8 +7,18 @@
 // segment (direction u, v; continuation).
 // The per-path slots are compacted into a dense, deterministic VPL list: by the shooting
 // workgroup itself when one workgroup holds every path (`shoot_and_compact`, the paper's
-// 30-180 VPLs: a dispatch of its own cost the frame a stage boundary, docs/PERFORMANCE.md
-// attempt 75), else by a second entry point (`compact`) after `shoot`.
+// 30-180 VPLs: a dispatch of its own cost the frame a stage boundary), else by a second
+// entry point (`compact`) after `shoot`.
+
+#import constants
+#import params
+#import scene
+#import traverse
+#import surface
+#import sampling
+#import ray_count
+#import vpl_record
+
 @group(1) @binding(1) var<storage, read_write> vpl_slots: array<Vpl>;
 @group(1) @binding(2) var<storage, read_write> vpls: array<Vpl>;
 @group(1) @binding(3) var<storage, read_write> vpl_header: VplHeader;
@@ -20,6 +30,9 @@ const PRIMES = array<u32, 64>(2u, 3u, 5u, 7u, 11u, 13u, 17u, 19u, 23u, 29u, 31u,
 
 // Sum of the primes before each dimension: where its permutation starts.
 const PERMUTATION_OFFSETS = array<u32, 64>(0u, 2u, 5u, 10u, 17u, 28u, 41u, 58u, 77u, 100u, 129u, 160u, 197u, 238u, 281u, 328u, 381u, 440u, 501u, 568u, 639u, 712u, 791u, 874u, 963u, 1060u, 1161u, 1264u, 1371u, 1480u, 1593u, 1720u, 1851u, 1988u, 2127u, 2276u, 2427u, 2584u, 2747u, 2914u, 3087u, 3266u, 3447u, 3638u, 3831u, 4028u, 4227u, 4438u, 4661u, 4888u, 5117u, 5350u, 5589u, 5830u, 6081u, 6338u, 6601u, 6870u, 7141u, 7418u, 7699u, 7982u, 8275u, 8582u);
+
+// The largest f32 below 1: where the radical inverse is clamped.
+const ONE_MINUS_EPSILON: f32 = 0.99999994;
 
 // Scrambled radical inverse, as igi_core::sampling::scrambled_radical_inverse computes it:
 // every digit of the index (and the zeros past its last one, up to base^k >= 2^32)
@@ -45,6 +58,10 @@ fn halton(dim_in: u32, index: u32) -> f32 {
 }
 
 const SHOOT_GROUP: u32 = 64u;
+
+fn mean3(v: vec3<f32>) -> f32 {
+    return (v.x + v.y + v.z) / 3.0;
+}
 
 // No light chosen: none emits.
 const NO_LIGHT: u32 = 0xffffffffu;
