@@ -1,25 +1,24 @@
 // rays_refill.wgsl: the any-hit query over a ray file for incoherent batches, with the
 // bindings and kernels of rays.wgsl (`RaySchedule::Refill` of raybench.rs). Aila and
-// Laine's persistent threads with dynamic ray fetch ("Understanding the Efficiency of Ray Traversal on
-// GPUs", 2009): a lane walks one node per loop iteration, and once enough lanes of its
-// subgroup have finished their rays, each idle lane takes the next ray of the batch from
-// a counter. With one ray per thread (any_hit), a warp of random segments runs as long as
-// its longest walk: its lanes walk 21 nodes on average but the warp 58 steps (the CPU
-// model of docs/PERFORMANCE.md attempt 109).
+// Laine's persistent threads with dynamic ray fetch ("Understanding the Efficiency of Ray
+// Traversal on GPUs", 2009): a lane walks one node per loop iteration, and once enough
+// lanes of its subgroup have finished their rays, each idle lane takes the next ray of
+// the batch from a counter. With one ray per thread (any_hit), a warp runs as long as its
+// longest walk, which for random segments is several times its lanes' average walk.
 //
 // Which ray a lane takes comes from its own atomic add: the subgroup's ballot only says
 // when to refill, so the answers never depend on how the driver keeps lanes together
 // (a leader's add for the whole subgroup, handed out by subgroupBroadcastFirst after a
-// branch, relies on the lanes meeting again after it; it measured 0.5% slower on an
-// H100, whose driver combines the lanes' adds, attempt 110).
+// branch, relies on the lanes meeting again after it; it was no faster on NVIDIA's
+// driver, which combines the lanes' adds itself).
 //
 // The answers are the walk's of trace_any (same functions, same order), ray for ray:
 // change any_hit_lanes with walk_any (tests/ray_schedules.rs compares both schedules with
 // the CPU twin, igi_core's Bvh::trace_any). The walk is written again here, not shared
-// with the gathers', whose schedule by the driver swings with trivial rewrites (attempt
-// 90). Coherent batches (neighbouring rays walk alike, as the renderer's VPL-major
+// with the gathers', whose schedule by the driver swings with trivial rewrites.
+// Coherent batches (neighbouring rays walk alike, as the renderer's VPL-major
 // shadow rays do) trace faster with one ray per thread: a refilled lane walks apart from
-// the lanes still on their old rays (the frame set 6.27 -> 5.48 G rays/s, attempt 110).
+// the lanes still on their old rays.
 
 #import scene
 #import traverse
@@ -29,8 +28,8 @@
 @group(1) @binding(3) var<storage, read_write> ray_counter: atomic<u32>;
 
 // Idle lanes refill once at least REFILL_IDLE / 64 of their subgroup's lanes are idle
-// (or all of its active ones). 48 (three quarters) and 40 measured best on an H100's
-// random segments, among 1, 16, 32, 40, 48, 56 and 60 (attempt 110).
+// (or all of its active ones). Three quarters measured best on random segments, among
+// thresholds from one lane to nearly all of them.
 override REFILL_IDLE: u32 = 48u;
 
 fn ballot_count(b: vec4<u32>) -> u32 {

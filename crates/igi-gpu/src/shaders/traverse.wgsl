@@ -28,8 +28,8 @@ const STACK_SIZE: u32 = 60u;
 // one per invocation, outside its loops over rays: WGSL zero-initialises a function's
 // variables where they are declared (naga writes a null initializer, which the NVIDIA
 // driver did not remove), so a stack declared in the walk cost every walk 240 bytes
-// of stores: 2.6% of a canonical frame on the H200 (docs/PERFORMANCE.md attempt 89). A
-// walk never reads an entry it did not push, so one stack serves any number of walks.
+// of stores, a visible share of a frame. A walk never reads an entry it did not push,
+// so one stack serves any number of walks.
 alias WalkStack = array<u32, STACK_SIZE>;
 
 // Direction components below this count as zero for the slab test (parallel axes).
@@ -117,8 +117,7 @@ fn make_ray(origin: vec3<f32>, dir: vec3<f32>, t_pad: f32) -> TraceRay {
     // included: measured from the origin moved up by the slack, and moved down by the
     // pad), exit planes where it is < 0 (moved up by the pad); the max corner's the
     // other way. Written otherwise, as selects between -(origin -+ slack) inv_dir -+ pad
-    // computed first (the same values), the NVIDIA driver made the canonical frame's
-    // gather 2% slower (docs/PERFORMANCE.md attempt 93).
+    // computed first (the same values), the NVIDIA driver made the gathers slower.
     let positive = inv_dir > vec3<f32>(0.0);
     let c_min = select(pad - oi, -(origin + slack) * inv_dir - pad, positive);
     let c_max = select(-oi - pad, -(origin - slack) * inv_dir + pad, positive);
@@ -153,21 +152,20 @@ fn slab_spans(bmin: vec3<f32>, bmax: vec3<f32>, r: TraceRay) -> SlabSpans {
 
 // Slab test: (entry, exit) distances of a box clipped to [0, tmax]; the box is hit when
 // entry <= exit. Each axis enters at the nearer plane and leaves at the farther (min and
-// max; with selects by the direction's sign instead, the NVIDIA driver spilled 12 bytes a
-// thread of the gather to shared memory and the gathers ran 3.5% slower,
-// docs/PERFORMANCE.md attempt 81). So the child no ray may hit is a point box at +inf,
-// not an inverted one (igi_core's BvhChild::EMPTY); tmax is always finite here (WGSL has
-// no infinity). Each plane's distance is one fused multiply-add with the ray's padded
-// offsets (igi_core's SLAB_PAD says why that stays conservative; one subtraction fewer
-// per plane than (b - o) * inv made canonical frames 2.3% faster, attempt 93). Parallel
-// axes need no case of their own: their offsets hold the moved origins (the select this
-// replaced cost 6-10% of every walk, attempt 35). The far end is scaled by far_scale:
-// BOX_TFAR_SCALE, or 1 on a segment walk, whose planes are padded instead
+// max; with selects by the direction's sign instead, the NVIDIA driver spilled registers
+// of the gather to shared memory and the gathers ran slower). So the child no ray may hit
+// is a point box at +inf, not an inverted one (igi_core's BvhChild::EMPTY); tmax is
+// always finite here (WGSL has no infinity). Each plane's distance is one fused
+// multiply-add with the ray's padded offsets (igi_core's SLAB_PAD says why that stays
+// conservative; it is one subtraction fewer per plane than (b - o) * inv, which made
+// frames faster). Parallel axes need no case of their own: their offsets hold the moved
+// origins (the select this replaced slowed every walk). The far end is scaled by
+// far_scale: BOX_TFAR_SCALE, or 1 on a segment walk, whose planes are padded instead
 // (SEGMENT_PAD).
 // The minima and maxima are taken on the distances' bits as signed integers, which order
 // like the floats they are wherever the answer depends on it (igi_core's box_span says
-// why): with float min and max, the walks ran 1-6% slower on the H200, with the same
-// answers (docs/PERFORMANCE.md attempt 104).
+// why): with float min and max, the walks ran slower on NVIDIA's driver, with the same
+// answers.
 fn box_span(bmin: vec3<f32>, bmax: vec3<f32>, r: TraceRay, tmax: f32, far_scale: f32) -> vec2<f32> {
     let d = plane_distances(bmin, bmax, r);
     let t0 = bitcast<vec3<i32>>(d.t0);
@@ -187,7 +185,7 @@ fn box_near(bmin: vec3<f32>, bmax: vec3<f32>, r: TraceRay, tmax: f32) -> f32 {
 }
 
 // Whether a box is hit within [0, tmax] (any hit needs no distance: without the select
-// and the compare that box_near's -1 costs, walks ran 1-2% faster, attempt 36).
+// and the compare that box_near's -1 costs, the walks are faster).
 fn box_hit(bmin: vec3<f32>, bmax: vec3<f32>, r: TraceRay, tmax: f32, far_scale: f32) -> bool {
     let span = box_span(bmin, bmax, r, tmax, far_scale);
     return span.x <= span.y;
@@ -195,8 +193,7 @@ fn box_hit(bmin: vec3<f32>, bmax: vec3<f32>, r: TraceRay, tmax: f32, far_scale: 
 
 // (v[k.x], v[k.y], v[k.z]), by selects: the ray's origin in its Woop axes (make_ray).
 // Indexing a vector with a run-time index (v[r.kx]) compiled to something much slower on
-// NVIDIA's Vulkan driver (the traversal ran 14-17% slower with it on an H200,
-// docs/PERFORMANCE.md attempt 5); the values are the same.
+// NVIDIA's Vulkan driver; the values are the same.
 fn woop_axes(v: vec3<f32>, k: vec3<u32>) -> vec3<f32> {
     return select(select(vec3<f32>(v.x), vec3<f32>(v.y), k == vec3<u32>(1u)), vec3<f32>(v.z), k == vec3<u32>(2u));
 }
@@ -206,9 +203,8 @@ fn woop_axes(v: vec3<f32>, k: vec3<u32>) -> vec3<f32> {
 // The triangle comes as its rows in the ray's Woop axes: xr = (v0, v1, v2)[kx], yr the
 // [ky] and zr the [kz] coordinates, read from tri_rows by index (slot_rows),
 // so that the test permutes nothing: stored as vertices, the coordinates took 18 selects
-// a test to pick, and without them random segments ran 4% faster,
-// closest hits 11.5% and canonical frames 2.2% (docs/PERFORMANCE.md attempt 102). The
-// values are the same: (v - o)[kx] = v[kx] - o[kx].
+// a test to pick, which slowed every kind of walk. The values are the same:
+// (v - o)[kx] = v[kx] - o[kx].
 fn intersect_triangle(r: TraceRay, xr: vec3<f32>, yr: vec3<f32>, zr: vec3<f32>, tmax: f32) -> vec3<f32> {
     let miss = vec3<f32>(-1.0, 0.0, 0.0);
     // Per row the three vertices moved to the origin: dx = (a.x, b.x, c.x) of the
@@ -381,12 +377,11 @@ fn trace_closest(stack: ptr<function, WalkStack>, origin: vec3<f32>, dir: vec3<f
 
 // Whether some triangle is hit with 0 < t < tmax (occlusion); returns at the first.
 // Children are visited in fixed order (a, then b): nearer-first ordering, which closest
-// hits need, made frames 4-7% slower here (docs/PERFORMANCE.md attempt 31; probably
-// because a fixed order keeps the walks of a warp's rays, which end at one point, in
-// step). The builder makes child a the likelier occluder per unit of work: the larger
-// ratio of triangle area to the interior nodes' SAH cost below it (attempt 84: canonical
-// 2.7% faster than the child of more triangle area, attempt 80, which was 3% faster than
-// the larger box first, attempt 41, which was 9-15% faster than the split's order).
+// hits need, made frames slower here (probably because a fixed order keeps the walks of
+// a warp's rays, which end at one point, in step). The builder makes child a the
+// likelier occluder per unit of work: the larger ratio of triangle area to the interior
+// nodes' SAH cost below it, which beat the child of more triangle area, the larger box
+// first and the split's order.
 // With `boxes` (imperfect visibility), a triangle whose box the segment crosses counts
 // as a hit (see box_crossed). The callers below pick the far end's margin: t_pad and
 // far_scale are constants there, which the compiler can fold into each walk.
@@ -444,9 +439,8 @@ fn trace_any(stack: ptr<function, WalkStack>, origin: vec3<f32>, dir: vec3<f32>,
 // Whether the segment from origin to origin + dir is occluded (0 < t < 1; see walk_any):
 // the renderer's shadow rays (shadow_segment). A segment's planes are padded by the
 // constant SEGMENT_PAD instead of scaling every far end by BOX_TFAR_SCALE: one product
-// fewer per box, and canonical frames 1.2-1.4% faster on the H200 (docs/PERFORMANCE.md
-// attempt 104; igi_core's SEGMENT_PAD says why it stays conservative). `boxes`: imperfect
-// visibility.
+// fewer per box, which made frames faster (igi_core's SEGMENT_PAD says why it stays
+// conservative). `boxes`: imperfect visibility.
 fn trace_segment(stack: ptr<function, WalkStack>, origin: vec3<f32>, dir: vec3<f32>, boxes: bool) -> bool {
     return walk_any(stack, origin, dir, 1.0, boxes, SEGMENT_PAD, 1.0);
 }
