@@ -1,6 +1,7 @@
 //! Host/GPU structs, `#[repr(C)]` + Pod, each documented field by field with byte offsets.
-//! The WGSL declarations live in `shaders/scene.wgsl` and `shaders/frame.wgsl`; a test
-//! (tests/layout.rs) checks sizes and offsets against what naga computes for the WGSL.
+//! The WGSL declarations live in `shaders/scene.wgsl`, `shaders/params.wgsl` and
+//! `shaders/vpl_record.wgsl` (and the display's in `passes/display/display.wgsl`); a test
+//! (tests/shaders.rs) checks sizes and offsets against what naga computes for the WGSL.
 
 use bytemuck::{Pod, Zeroable};
 
@@ -154,7 +155,7 @@ pub struct FrameParams {
 }
 
 /// Parameters of the viewer's display pass (uniform buffer, 48 bytes, storage on software
-/// adapters as [`FrameParams`]; `shaders/display.wgsl`).
+/// adapters as [`FrameParams`]; `passes/display/display.wgsl`).
 /// | offset | field | |
 /// |---|---|---|
 /// | 0 | viewport: vec4f | the image's rectangle in the target: x, y, width, height (pixels) |
