@@ -94,6 +94,45 @@ fn every_module_is_named_once_and_used() {
     }
 }
 
+/// What each `.w` of the G-buffer and of the mirror record means is written in
+/// gbuffer.wgsl alone: no other frame shader reads a `.w` or writes a record with a `vec4`
+/// of its own (the ray bench's ray records are not the G-buffer).
+#[test]
+fn only_gbuffer_wgsl_packs_and_unpacks_the_records() {
+    let frame_shaders = SOURCES
+        .iter()
+        .filter(|pass| !pass.name.starts_with("rays"))
+        .map(|pass| (pass.name, pass.wgsl))
+        .chain(MODULES.iter().copied().filter(|(name, _)| *name != "rays"));
+    let records = [
+        "gbuf_position[",
+        "gbuf_normal[",
+        "gbuf_geometric[",
+        "gbuf_albedo[",
+        "mirror_position[",
+        "mirror_normal[",
+        "mirror_geometric[",
+        "mirror_weight[",
+    ];
+    for (name, wgsl) in frame_shaders {
+        if name == "gbuffer" {
+            continue;
+        }
+        for (i, line) in wgsl.lines().enumerate() {
+            let code = line.split("//").next().unwrap();
+            let reads_w = code.match_indices(".w").any(|(at, _)| {
+                !code[at + 2..].starts_with(|c: char| c.is_alphanumeric() || c == '_')
+            });
+            let writes_vec4 = records.iter().any(|r| code.contains(r)) && code.contains("= vec4");
+            assert!(
+                !reads_w && !writes_vec4,
+                "{name}.wgsl line {}: use gbuffer.wgsl's functions: {line}",
+                i + 1
+            );
+        }
+    }
+}
+
 /// Software adapters get no uniform buffers at all (lavapipe recompiles shaders whose
 /// branches depend on uniform values every time they are bound, see `ParamsBinding`),
 /// and GPUs get the blocks as uniform buffers still.
