@@ -190,7 +190,9 @@ fn run_upsampler(ctx: &GpuContext, w: u32, h: u32, s: u32, low: &[f32]) -> Vec<[
     let zero = storage_buffer(ctx, "zero", &zeros).unwrap();
     let bind = compose.bind(
         &ctx.device,
-        &[&uniform, &zero, &zero, &inp, &out, &pos, &nrm, &zero, &zero],
+        // params, G-buffer position and normal, E, colour, direct, albedo, mirror weight
+        // and E (compose.wgsl's bindings 0-8).
+        &[&uniform, &pos, &nrm, &inp, &out, &zero, &zero, &zero, &zero],
     );
     let mut encoder = ctx.device.create_command_encoder(&Default::default());
     {
