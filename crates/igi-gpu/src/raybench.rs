@@ -7,10 +7,12 @@
 
 use crate::context::{GpuContext, GpuError};
 use crate::layout::FrameParams;
-use crate::passes::{bind, pass_layout, pipeline};
+use crate::passes::bindings::{bind, compute_layout};
+use crate::passes::pipeline;
 use crate::profiler::{Profiler, WarmUp};
-use crate::scene_buffers::{storage_buffer, SceneBuffers, READ, UNIFORM, WRITE};
+use crate::scene_buffers::{storage_buffer, SceneBuffers};
 use crate::shader::ParamsBinding;
+use crate::switches::Switches;
 use glam::Vec3;
 use igi_core::bvh::Bvh;
 use igi_core::rays::RayRecord;
@@ -118,6 +120,27 @@ pub struct RayTiming {
     pub distances: Vec<f32>,
 }
 
+crate::bindings! {
+    /// Bind group 1 of rays.wgsl.
+    pub struct RayBindings {
+        /// Unused by the kernels, but the shared modules declare it.
+        params: Params,
+        rays: Read,
+        results: Write,
+    }
+}
+
+crate::bindings! {
+    /// Bind group 1 of the refill schedule (rays.wgsl's, then rays_refill.wgsl's counter).
+    pub struct RefillBindings {
+        params: Params,
+        rays: Read,
+        results: Write,
+        /// The next ray to hand out.
+        ray_counter: Write,
+    }
+}
+
 pub struct RayBench {
     scene: SceneBuffers,
     layout: wgpu::BindGroupLayout,
@@ -135,8 +158,8 @@ pub struct RayBench {
 impl RayBench {
     pub fn new(ctx: &GpuContext, scene: &Scene, bvh: &Bvh) -> Result<RayBench, GpuError> {
         let scene_buffers = SceneBuffers::upload(ctx, scene, bvh)?;
-        // params (unused, but frame.wgsl declares it), rays, results
-        let layout = pass_layout(&ctx.device, "rays", &[UNIFORM, READ, WRITE]);
+        let switches = Switches::from_env();
+        let layout = compute_layout::<RayBindings>(&ctx.device, "rays");
         let layouts = [&scene_buffers.layout, &layout];
         let params = wgpu::util::DeviceExt::create_buffer_init(
             &ctx.device,
@@ -147,9 +170,10 @@ impl RayBench {
             },
         );
         let refill = refill_offered(ctx).then(|| {
-            let layout = pass_layout(&ctx.device, "rays refill", &[UNIFORM, READ, WRITE, WRITE]);
+            let layout = compute_layout::<RefillBindings>(&ctx.device, "rays refill");
             let refill = pipeline(
                 &ctx.device,
+                &switches,
                 "rays_refill",
                 "any_hit_refill",
                 &[&scene_buffers.layout, &layout],
@@ -159,8 +183,8 @@ impl RayBench {
         Ok(RayBench {
             refill,
             refill_groups: REFILL_GROUPS,
-            any_hit: pipeline(&ctx.device, "rays", "any_hit", &layouts),
-            closest_hit: pipeline(&ctx.device, "rays", "closest_hit", &layouts),
+            any_hit: pipeline(&ctx.device, &switches, "rays", "any_hit", &layouts),
+            closest_hit: pipeline(&ctx.device, &switches, "rays", "closest_hit", &layouts),
             scene: scene_buffers,
             layout,
             params,
@@ -224,13 +248,23 @@ impl RayBench {
             .iter()
             .enumerate()
             .map(|(k, (i, o, _))| match refill {
-                Some((layout, _)) => bind(
-                    &ctx.device,
-                    "rays refill",
-                    layout,
-                    &[&self.params, i, o, &counters[k]],
-                ),
-                None => bind(&ctx.device, "rays", &self.layout, &[&self.params, i, o]),
+                Some((layout, _)) => {
+                    let bindings = RefillBindings {
+                        params: &self.params,
+                        rays: i,
+                        results: o,
+                        ray_counter: &counters[k],
+                    };
+                    bind(&ctx.device, "rays refill", layout, &bindings).group
+                }
+                None => {
+                    let bindings = RayBindings {
+                        params: &self.params,
+                        rays: i,
+                        results: o,
+                    };
+                    bind(&ctx.device, "rays", &self.layout, &bindings).group
+                }
             })
             .collect();
         let pipeline = match (query, refill) {
