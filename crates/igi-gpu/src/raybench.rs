@@ -27,9 +27,8 @@ const RAY_GROUP: u32 = 64;
 
 /// Workgroups of a refill dispatch, whatever the batch: more than the largest GPUs hold at
 /// once (an H100 holds about 3,200 of these), since workgroups that start after the batch
-/// is handed out leave at once. On an H100's random segments 4,096, 8,192 and 16,384
-/// measured within 0.7% of each other; 2,112 and 1,056 were 2.5% and 24% slower than
-/// 4,096 (at REFILL_IDLE 32; docs/PERFORMANCE.md attempt 110).
+/// is handed out leave at once; fewer than the GPU holds left it part idle on an H100
+/// (docs/lab/PERFORMANCE.md has the comparison).
 const REFILL_GROUPS: u32 = 8192;
 
 /// How the any-hit kernel hands rays to threads.
@@ -48,9 +47,8 @@ pub enum RaySchedule {
 /// ballot that says when to refill). Not on software adapters: on lavapipe (Mesa 22.3.6)
 /// the refill loop returns a few rays in ten thousand untraced (tests/ray_schedules.rs
 /// showed it, with every run's results cleared first), even with no subgroup operation
-/// in the choice of rays, while on NVIDIA's driver every ray of 16.8 M random segments,
-/// 8 M more and 60.3 M frame rays was answered as one ray per thread answers it
-/// (docs/PERFORMANCE.md attempt 110).
+/// in the choice of rays, while on NVIDIA's driver every ray of the bench's ray sets was
+/// answered as one ray per thread answers it.
 pub fn refill_offered(ctx: &GpuContext) -> bool {
     ctx.subgroups && !ctx.is_software()
 }

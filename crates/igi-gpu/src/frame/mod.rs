@@ -632,8 +632,7 @@ impl Renderer {
         // counted first, by its own VPL pass run alone (the same paths leave the same
         // VPLs when the frame runs it again), and the ranges cover them, not every slot
         // the paths could fill: where most paths leave the scene at once the two differ a
-        // hundredfold (one mirror triangle: 9 VPLs in 1,872 slots, whose 234 ranges took
-        // 2.5-10 s a frame on llvmpipe).
+        // hundredfold (a scene of one mirror triangle left 9 VPLs in 1,872 slots).
         let vpls = if self.vpls_per_dispatch == u32::MAX {
             paths as u64 * bounces as u64
         } else {
