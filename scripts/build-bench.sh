@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The BVH build figure of docs/PERFORMANCE.md (issue "Fast": <= 100 ms on the 2-core
+# The BVH build figure of docs/BENCHMARKS.md (issue "Fast": <= 100 ms on the 2-core
 # machine) in one command, on the CPU machine:
 #
 #   scripts/build-bench.sh [ROUNDS] [BIN...]

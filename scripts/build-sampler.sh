@@ -4,7 +4,7 @@
 #
 #   scripts/build-sampler.sh [MINUTES] [BIN...]      (default: 60 minutes)
 #
-# The 2-core machine's speed changes from minute to minute (docs/PERFORMANCE.md attempts
+# The 2-core machine's speed changes from minute to minute (docs/lab/PERFORMANCE.md attempts
 # 114 and 129: in some minutes it runs a two-thread build on one core), so one set of
 # builds says little about the next hour. Every INTERVAL seconds (default 180) while
 # nothing else keeps the machine busy (no compiler, a 1-minute load average under 0.6)

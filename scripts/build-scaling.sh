@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# How the BVH build scales with threads on this machine's CPU (docs/BENCHMARKS.md, "The
+# How the BVH build scales with threads on this machine's CPU (docs/lab/BENCHMARKS-history.md, "The
 # BVH build on other CPUs"): for 1, 2, 4, ... threads up to the CPU count, a round of 11
 # builds in one process (`bvh_build SCENE 11 --build-only`) and 5 single builds in new
 # processes, each under RAYON_NUM_THREADS.

@@ -3,7 +3,7 @@
 //! fit on the GPU at once) recorded in patterns of the buffers they write. A dispatch
 //! that binds a buffer an earlier dispatch of the pass wrote gets a barrier from wgpu;
 //! the others get none. Prints the median GPU time of each pattern against one dispatch
-//! alone. A measuring tool for docs/PERFORMANCE.md (attempt 65).
+//! alone. A measuring tool for how the recorder groups passes (`frame/recorder.rs`).
 //!
 //! `cargo run --release -p igi-gpu --example overlap_probe -- [ITERATIONS] [RUNS]`
 

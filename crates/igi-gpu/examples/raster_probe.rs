@@ -1,10 +1,10 @@
 //! What a rasterised visibility buffer of a scene would cost on this GPU: the scene's
 //! triangles drawn once from its camera into a triangle-index target with a depth
 //! buffer, timed with GPU timestamps, and compared pixel by pixel with the closest hits
-//! of igi's own traversal of the same camera rays (pixel centres). A measuring tool for
-//! docs/PERFORMANCE.md (attempts 46, 53 and 64): the direct pass's primary closest hits
-//! cost about 0.09 ms of the H200 at 800 x 600, and NVIDIA's Hopper GPUs keep graphics
-//! units in only two of their TPCs, so whether rasterising is cheaper had to be measured.
+//! of igi's own traversal of the same camera rays (pixel centres). A measuring tool: the
+//! direct pass's primary closest hits are a small part of the frame, and NVIDIA's Hopper
+//! GPUs keep graphics units in only two of their TPCs, so whether rasterising is cheaper
+//! had to be measured (the lab log has the answer).
 //!
 //! `cargo run --release -p igi-gpu --example raster_probe -- SCENE.toml [WIDTH HEIGHT]
 //! [FRAMES]` (default: the scene's film, 200 frames); prints the median GPU time of the

@@ -1,7 +1,7 @@
 //! What the Vulkan driver made of a pass's shader: register count, local (spill) memory,
 //! shared memory, instruction count... as the driver reports them through
-//! VK_KHR_pipeline_executable_properties. A measuring tool for the traversal work of
-//! docs/PERFORMANCE.md (occupancy decides how well a walk hides its memory latency).
+//! VK_KHR_pipeline_executable_properties. A measuring tool for the traversal (occupancy
+//! decides how well a walk hides its memory latency).
 //!
 //! `cargo run --release -p igi-gpu --example shader_stats -- PASS ENTRY [NAME=VALUE...]`,
 //! e.g. `rays any_hit` or `indirect main_coherent COHERENT_LANES=4`. The WGSL is composed
@@ -10,7 +10,7 @@
 //! driver on a device opened through wgpu with the extension enabled. NVIDIA's driver
 //! (580) reports the register count, binary size, local and shared memory; it gives no
 //! internal representation (no SASS). llvmpipe lacks the extension: the tool says so and
-//! exits with 1. Register counts measured with it are in docs/PERFORMANCE.md (attempt 45).
+//! exits with 1. Register counts measured with it are in the lab log (docs/lab/).
 
 use std::ffi::CStr;
 

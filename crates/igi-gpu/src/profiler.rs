@@ -3,7 +3,7 @@
 //! inside one compute pass, one timestamp between two stages, the end of one and the
 //! start of the next, so that the stage times add up to the frame time (what falls
 //! between two stages, the barrier and the start of the next dispatch, counts for the
-//! next: docs/PERFORMANCE.md attempt 73).
+//! next).
 
 use std::cell::Cell;
 use std::time::Instant;
@@ -12,9 +12,8 @@ use crate::context::{GpuContext, GpuError};
 
 /// Least wall time of untimed work before timed GPU work: an idle GPU clocks down within
 /// a second, and a few short warm-up runs (3 frames, or 3 traces of 10 ms) do not bring
-/// its clocks back up. Medians of `igi bench` doubled without it (docs/PERFORMANCE.md
-/// attempt 4), and a trace of the frame's shadow rays right after OptiX had run took a
-/// median of 29.7 ms over its 10 runs instead of 9.5 ms (attempt 126).
+/// its clocks back up: without it the bench's medians measured the clocking, not the
+/// work, and so did a trace of rays right after another program had used the GPU.
 pub const WARMUP_SECONDS: f64 = 0.5;
 
 /// The untimed runs before timed ones: at least `runs` of them, and while there are any,

@@ -7,10 +7,12 @@
 
 use crate::context::{GpuContext, GpuError};
 use crate::layout::FrameParams;
-use crate::passes::{bind, pass_layout, pipeline};
+use crate::passes::bindings::{bind, compute_layout};
+use crate::passes::pipeline;
 use crate::profiler::{Profiler, WarmUp};
-use crate::scene_buffers::{storage_buffer, SceneBuffers, READ, UNIFORM, WRITE};
+use crate::scene_buffers::{storage_buffer, SceneBuffers};
 use crate::shader::ParamsBinding;
+use crate::switches::Switches;
 use glam::Vec3;
 use igi_core::bvh::Bvh;
 use igi_core::rays::RayRecord;
@@ -25,9 +27,8 @@ const RAY_GROUP: u32 = 64;
 
 /// Workgroups of a refill dispatch, whatever the batch: more than the largest GPUs hold at
 /// once (an H100 holds about 3,200 of these), since workgroups that start after the batch
-/// is handed out leave at once. On an H100's random segments 4,096, 8,192 and 16,384
-/// measured within 0.7% of each other; 2,112 and 1,056 were 2.5% and 24% slower than
-/// 4,096 (at REFILL_IDLE 32; docs/PERFORMANCE.md attempt 110).
+/// is handed out leave at once; fewer than the GPU holds left it part idle on an H100
+/// (docs/lab/PERFORMANCE.md has the comparison).
 const REFILL_GROUPS: u32 = 8192;
 
 /// How the any-hit kernel hands rays to threads.
@@ -46,9 +47,8 @@ pub enum RaySchedule {
 /// ballot that says when to refill). Not on software adapters: on lavapipe (Mesa 22.3.6)
 /// the refill loop returns a few rays in ten thousand untraced (tests/ray_schedules.rs
 /// showed it, with every run's results cleared first), even with no subgroup operation
-/// in the choice of rays, while on NVIDIA's driver every ray of 16.8 M random segments,
-/// 8 M more and 60.3 M frame rays was answered as one ray per thread answers it
-/// (docs/PERFORMANCE.md attempt 110).
+/// in the choice of rays, while on NVIDIA's driver every ray of the bench's ray sets was
+/// answered as one ray per thread answers it.
 pub fn refill_offered(ctx: &GpuContext) -> bool {
     ctx.subgroups && !ctx.is_software()
 }
@@ -118,6 +118,27 @@ pub struct RayTiming {
     pub distances: Vec<f32>,
 }
 
+crate::bindings! {
+    /// Bind group 1 of rays.wgsl.
+    pub struct RayBindings {
+        /// Unused by the kernels, but the shared modules declare it.
+        params: Params,
+        rays: Read,
+        results: Write,
+    }
+}
+
+crate::bindings! {
+    /// Bind group 1 of the refill schedule (rays.wgsl's, then rays_refill.wgsl's counter).
+    pub struct RefillBindings {
+        params: Params,
+        rays: Read,
+        results: Write,
+        /// The next ray to hand out.
+        ray_counter: Write,
+    }
+}
+
 pub struct RayBench {
     scene: SceneBuffers,
     layout: wgpu::BindGroupLayout,
@@ -135,8 +156,8 @@ pub struct RayBench {
 impl RayBench {
     pub fn new(ctx: &GpuContext, scene: &Scene, bvh: &Bvh) -> Result<RayBench, GpuError> {
         let scene_buffers = SceneBuffers::upload(ctx, scene, bvh)?;
-        // params (unused, but frame.wgsl declares it), rays, results
-        let layout = pass_layout(&ctx.device, "rays", &[UNIFORM, READ, WRITE]);
+        let switches = Switches::from_env();
+        let layout = compute_layout::<RayBindings>(&ctx.device, "rays");
         let layouts = [&scene_buffers.layout, &layout];
         let params = wgpu::util::DeviceExt::create_buffer_init(
             &ctx.device,
@@ -147,9 +168,10 @@ impl RayBench {
             },
         );
         let refill = refill_offered(ctx).then(|| {
-            let layout = pass_layout(&ctx.device, "rays refill", &[UNIFORM, READ, WRITE, WRITE]);
+            let layout = compute_layout::<RefillBindings>(&ctx.device, "rays refill");
             let refill = pipeline(
                 &ctx.device,
+                &switches,
                 "rays_refill",
                 "any_hit_refill",
                 &[&scene_buffers.layout, &layout],
@@ -159,8 +181,8 @@ impl RayBench {
         Ok(RayBench {
             refill,
             refill_groups: REFILL_GROUPS,
-            any_hit: pipeline(&ctx.device, "rays", "any_hit", &layouts),
-            closest_hit: pipeline(&ctx.device, "rays", "closest_hit", &layouts),
+            any_hit: pipeline(&ctx.device, &switches, "rays", "any_hit", &layouts),
+            closest_hit: pipeline(&ctx.device, &switches, "rays", "closest_hit", &layouts),
             scene: scene_buffers,
             layout,
             params,
@@ -224,13 +246,23 @@ impl RayBench {
             .iter()
             .enumerate()
             .map(|(k, (i, o, _))| match refill {
-                Some((layout, _)) => bind(
-                    &ctx.device,
-                    "rays refill",
-                    layout,
-                    &[&self.params, i, o, &counters[k]],
-                ),
-                None => bind(&ctx.device, "rays", &self.layout, &[&self.params, i, o]),
+                Some((layout, _)) => {
+                    let bindings = RefillBindings {
+                        params: &self.params,
+                        rays: i,
+                        results: o,
+                        ray_counter: &counters[k],
+                    };
+                    bind(&ctx.device, "rays refill", layout, &bindings).group
+                }
+                None => {
+                    let bindings = RayBindings {
+                        params: &self.params,
+                        rays: i,
+                        results: o,
+                    };
+                    bind(&ctx.device, "rays", &self.layout, &bindings).group
+                }
             })
             .collect();
         let pipeline = match (query, refill) {

@@ -10,11 +10,10 @@ pub struct SceneBuffers {
     pub layout: wgpu::BindGroupLayout,
     pub bind_group: wgpu::BindGroup,
     /// The same scene with spare ray counters, one set per pass that runs beside another
-    /// one in a frame that counts nothing (`[0]`: the direct pass beside VPL shooting, `[1]`
-    /// and `[2]`: the mirror gather and the indirect gather beside the mirror chains' walks,
-    /// `[3]`: the mirror discontinuity buffer beside the indirect term's filter): wgpu puts
-    /// a barrier before a dispatch that binds read-write a buffer an earlier dispatch of
-    /// the frame bound read-write, even when neither writes it (`Recorder::side_by_side`).
+    /// one in a frame that counts nothing, each used once a frame (the recorder hands
+    /// them out in order): wgpu puts a barrier before a dispatch that binds read-write a
+    /// buffer an earlier dispatch of the frame bound read-write, even when neither writes
+    /// it (`frame::recorder`).
     pub beside_bind_groups: [wgpu::BindGroup; SPARE_COUNTERS],
     pub light_count: u32,
     /// The point lights (binding 4), rewritten when the viewer moves a light.
@@ -25,29 +24,23 @@ pub struct SceneBuffers {
     pub bytes: u64,
 }
 
-/// Sets of spare ray counters (see [`SceneBuffers::beside_bind_groups`]).
+/// Sets of spare ray counters (see [`SceneBuffers::beside_bind_groups`]): as many as a
+/// frame has passes beside another (the direct pass, the two gathers beside the chain
+/// walks, the mirror discontinuity buffer).
 pub const SPARE_COUNTERS: usize = 4;
 
-/// A bind group layout entry for a compute-stage storage or uniform buffer.
-pub fn buffer_entry(binding: u32, ty: wgpu::BufferBindingType) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::COMPUTE,
-        ty: wgpu::BindingType::Buffer {
-            ty,
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
+crate::bindings! {
+    /// Bind group 0 of every pass (scene.wgsl).
+    pub struct SceneBindings {
+        bvh_nodes: Read,
+        tri_rows: Read,
+        tri_shading: Read,
+        materials: Read,
+        lights: Read,
+        /// Rays traced per kind, counted only in frames that count them.
+        ray_counters: Write,
     }
 }
-
-pub const READ: wgpu::BufferBindingType = wgpu::BufferBindingType::Storage { read_only: true };
-pub const WRITE: wgpu::BufferBindingType = wgpu::BufferBindingType::Storage { read_only: false };
-/// A parameter block (a `var<uniform>` of the WGSL) in a list of `passes::pass_layout`:
-/// a uniform buffer, or a read-only storage buffer on software adapters
-/// ([`crate::shader::ParamsBinding`]), which `pass_layout` picks for its device.
-pub const UNIFORM: wgpu::BufferBindingType = wgpu::BufferBindingType::Uniform;
 
 /// A storage buffer with `data` (at least 16 bytes: empty arrays still need a binding),
 /// after checking it fits one binding on this device.
@@ -108,12 +101,7 @@ pub fn gpu_lights(lights: &[igi_core::scene::PointLight]) -> Vec<GpuLight> {
 
 impl SceneBuffers {
     pub fn layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
-        device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("scene"),
-            entries: &(0..6)
-                .map(|b| buffer_entry(b, if b == 5 { WRITE } else { READ }))
-                .collect::<Vec<_>>(),
-        })
+        crate::passes::bindings::compute_layout::<SceneBindings>(device, "scene")
     }
 
     pub fn upload(ctx: &GpuContext, scene: &Scene, bvh: &Bvh) -> Result<SceneBuffers, GpuError> {
@@ -167,21 +155,17 @@ impl SceneBuffers {
         for _ in 0..SPARE_COUNTERS {
             spare_counters.push(storage_buffer(ctx, "spare ray counters", &[0u8; 32])?);
         }
-        let group = |label: &str, counters: &wgpu::Buffer| {
-            let entries: Vec<wgpu::BindGroupEntry> = buffers
-                .iter()
-                .chain([counters])
-                .enumerate()
-                .map(|(i, b)| wgpu::BindGroupEntry {
-                    binding: i as u32,
-                    resource: b.as_entire_binding(),
-                })
-                .collect();
-            ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some(label),
-                layout: &layout,
-                entries: &entries,
-            })
+        let group = |label: &str, ray_counters: &wgpu::Buffer| {
+            let [bvh_nodes, tri_rows, tri_shading, materials, lights] = &buffers;
+            let bindings = SceneBindings {
+                bvh_nodes,
+                tri_rows,
+                tri_shading,
+                materials,
+                lights,
+                ray_counters,
+            };
+            crate::passes::bindings::bind(&ctx.device, label, &layout, &bindings).group
         };
         let bind_group = group("scene", &ray_counters);
         let beside_bind_groups =

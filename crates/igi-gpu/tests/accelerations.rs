@@ -12,7 +12,7 @@ use igi_core::image::{rel_mse, Image};
 use igi_core::scene::{load_scene, Camera, PointLight, Scene};
 use igi_core::settings::{Accelerations, FilterMode, OutputBuffer, RenderSettings};
 use igi_gpu::layout::FrameParams;
-use igi_gpu::passes::compose::ComposePass;
+use igi_gpu::passes::compose::{ComposeBindings, ComposePass};
 use igi_gpu::scene_buffers::{storage_buffer, SceneBuffers};
 use igi_gpu::GpuContext;
 
@@ -142,7 +142,11 @@ fn run_upsampler(ctx: &GpuContext, w: u32, h: u32, s: u32, low: &[f32]) -> Vec<[
     );
     let bvh = Bvh::build(&scene.triangles);
     let scene_buffers = SceneBuffers::upload(ctx, &scene, &bvh).unwrap();
-    let compose = ComposePass::new(&ctx.device, &scene_buffers.layout);
+    let compose = ComposePass::new(
+        &ctx.device,
+        &igi_gpu::switches::Switches::default(),
+        &scene_buffers.layout,
+    );
     let (lw, lh) = (w.div_ceil(s), h.div_ceil(s));
     let params = FrameParams {
         width: w,
@@ -190,9 +194,17 @@ fn run_upsampler(ctx: &GpuContext, w: u32, h: u32, s: u32, low: &[f32]) -> Vec<[
     let zero = storage_buffer(ctx, "zero", &zeros).unwrap();
     let bind = compose.bind(
         &ctx.device,
-        // params, G-buffer position and normal, E, colour, direct, albedo, mirror weight
-        // and E (compose.wgsl's bindings 0-8).
-        &[&uniform, &pos, &nrm, &inp, &out, &zero, &zero, &zero, &zero],
+        &ComposeBindings {
+            params: &uniform,
+            direct_in: &zero,
+            gbuf_albedo: &zero,
+            irradiance_in: &inp,
+            color_out: &out,
+            gbuf_position: &pos,
+            gbuf_normal: &nrm,
+            mirror_weight: &zero,
+            mirror_irradiance: &zero,
+        },
     );
     let mut encoder = ctx.device.create_command_encoder(&Default::default());
     {

@@ -1,7 +1,7 @@
 //! A long run of frames holds its memory. On lavapipe, shaders whose branches or loops
 //! depended on uniform values alone were compiled again every time their pipeline was
-//! bound, and every copy was kept: about 1.35 MB a frame (docs/PERFORMANCE.md attempt
-//! 123, `igi_gpu::shader::ParamsBinding`). A test binary of its own, so that no other
+//! bound, and every copy was kept, more than a megabyte a frame
+//! (`igi_gpu::shader::ParamsBinding`). A test binary of its own, so that no other
 //! test allocates while this one reads the process's resident memory.
 
 mod common;

@@ -201,7 +201,10 @@ fn mirrored_hits_gather_from_all_vpls() {
         "the floor should fill the bottom of the image: {checked}"
     );
     let software = gpu().is_some_and(|c| c.is_software());
-    let per_group = list_pixels_per_group(mirror_lanes(software));
+    let per_group = list_pixels_per_group(mirror_lanes(
+        software,
+        &igi_gpu::switches::Switches::from_env(),
+    ));
     assert!(
         checked > per_group,
         "{checked} mirrored pixels fit one workgroup of {per_group}: no stride tested"

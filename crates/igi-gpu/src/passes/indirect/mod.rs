@@ -3,10 +3,34 @@
 //! (at the indirect term's resolution), and, with a second set of parameters at full
 //! resolution, the first diffuse hits seen through mirrors (the "mirror indirect" stage;
 //! the paper gathers every VPL there and leaves that cost as future work).
-//! See `shaders/indirect.wgsl`.
+//! See `indirect.wgsl`.
 
-use super::{bind, pass_layout, GatherPipelines, LanePipelines, Step};
-use crate::scene_buffers::{READ, UNIFORM, WRITE};
+use super::bindings::{bind, compute_layout};
+use super::{GatherPipelines, LanePipelines, Step};
+use crate::frame::recorder::FramePass;
+use crate::frame::resources::{Buf, FrameBuffers};
+use crate::frame::FrameShape;
+use crate::switches::Switches;
+
+crate::bindings! {
+    /// Bind group 1 of indirect.wgsl: a G-buffer record to gather at and where E goes.
+    pub struct IndirectBindings {
+        params: Params,
+        vpls: Read,
+        vpl_header: Read,
+        gbuf_position: Read,
+        gbuf_normal: Read,
+        gbuf_geometric: Read,
+        irradiance_out: Write,
+    }
+}
+
+crate::bindings! {
+    /// Bind group 3 of the gather over the mirrored pixels: direct.wgsl's list of them.
+    pub struct MirrorListBindings {
+        mirror_list: Read,
+    }
+}
 
 /// Threads of a workgroup of the gather over the list of mirrored pixels (indirect.wgsl
 /// `LIST_GROUP`) with `lanes` lanes per pixel: 256, or 32 per lane where that is more, so
@@ -22,10 +46,8 @@ pub fn list_pixels_per_group(lanes: u32) -> u32 {
 
 /// The most workgroups of the gather over the list of mirrored pixels, over all its
 /// buckets: they stride over the list, whose length is known only on the GPU (a dispatch
-/// sized there cost the frame more than a fixed grid, docs/PERFORMANCE.md attempt 75).
-/// Grids of 256 to 4096 took the same time within 0.005 ms on the H200 (conference room,
-/// 800 x 600 and 1920 x 1080, interleaved or not); 1024 was never more than that from the
-/// best.
+/// sized there cost the frame more than a fixed grid). Grids of 256 to 4096 workgroups
+/// measured alike on the H200; 1024 was never far from the best.
 pub const LIST_WORKGROUPS: u32 = 1024;
 
 pub struct IndirectPass {
@@ -45,17 +67,13 @@ impl IndirectPass {
     /// ([`super::mirror_lanes`]).
     pub fn new(
         device: &wgpu::Device,
+        switches: &Switches,
         scene_layout: &wgpu::BindGroupLayout,
         range_layout: &wgpu::BindGroupLayout,
         list_lanes: u32,
     ) -> IndirectPass {
-        // params, vpls, vpl_header, position, normal, geometric, irradiance
-        let layout = pass_layout(
-            device,
-            "indirect",
-            &[UNIFORM, READ, READ, READ, READ, READ, WRITE],
-        );
-        let list_layout = pass_layout(device, "mirror list", &[READ]);
+        let layout = compute_layout::<IndirectBindings>(device, "indirect");
+        let list_layout = compute_layout::<MirrorListBindings>(device, "mirror list");
         let layouts = [scene_layout, &layout, range_layout, &list_layout];
         let constants = [
             ("VPL_LANES", list_lanes as f64),
@@ -64,19 +82,22 @@ impl IndirectPass {
         IndirectPass {
             pipelines: LanePipelines::new(
                 device,
+                switches,
                 "indirect",
                 &[scene_layout, &layout, range_layout],
             ),
-            list: GatherPipelines::new(device, "indirect", "main_list", &layouts, &constants),
+            list: GatherPipelines::new(
+                device,
+                switches,
+                "indirect",
+                "main_list",
+                &layouts,
+                &constants,
+            ),
             list_pixels: list_pixels_per_group(list_lanes),
             list_layout,
             layout,
         }
-    }
-
-    /// Bind group 3 of the list gather (the list).
-    pub fn bind_list(&self, device: &wgpu::Device, list: &wgpu::Buffer) -> wgpu::BindGroup {
-        bind(device, "mirror list", &self.list_layout, &[list])
     }
 
     /// The gather over the listed pixels of a `width` x `height` image interleaved in
@@ -99,10 +120,6 @@ impl IndirectPass {
         [(self.list.get(imperfect_visibility), [groups, 1, subsets])]
     }
 
-    pub fn bind(&self, device: &wgpu::Device, buffers: &[&wgpu::Buffer; 7]) -> wgpu::BindGroup {
-        bind(device, "indirect", &self.layout, buffers)
-    }
-
     /// The dispatch over a `width` x `height` record interleaved in tiles of
     /// `interleave` pixels, each pixel's VPLs split over `lanes` threads (see
     /// [`super::lanes_for`]).
@@ -117,5 +134,65 @@ impl IndirectPass {
         [self
             .pipelines
             .step(width, height, imperfect_visibility, lanes, interleave)]
+    }
+
+    /// E at the primary hits, at the indirect term's resolution, each pixel's VPLs split
+    /// over the frame's lanes, interleaved in its tiles.
+    pub(crate) fn record_primary<'a>(
+        &'a self,
+        device: &wgpu::Device,
+        buffers: &'a FrameBuffers,
+        shape: &FrameShape<'a>,
+    ) -> FramePass<'a> {
+        let (low, iv) = (shape.low, shape.imperfect_visibility);
+        let b = |buf| buffers.get(buf);
+        let bindings = IndirectBindings {
+            params: b(Buf::Params),
+            vpls: b(Buf::Vpls),
+            vpl_header: b(Buf::VplHeader),
+            gbuf_position: b(Buf::GbufPosition),
+            gbuf_normal: b(Buf::GbufNormal),
+            gbuf_geometric: b(Buf::GbufGeometric),
+            irradiance_out: b(Buf::Irradiance),
+        };
+        FramePass::new(
+            "indirect",
+            self.steps(low.0, low.1, iv, shape.lanes, shape.interleave)
+                .to_vec(),
+            bind(device, "indirect", &self.layout, &bindings),
+        )
+        .over(shape.ranges)
+    }
+
+    /// E at the first diffuse hits seen through mirrors (full resolution, the mirror
+    /// parameters), only at the pixels the direct pass listed.
+    pub(crate) fn record_mirrored<'a>(
+        &'a self,
+        device: &wgpu::Device,
+        buffers: &'a FrameBuffers,
+        shape: &FrameShape<'a>,
+    ) -> FramePass<'a> {
+        let (full, iv) = (shape.full, shape.imperfect_visibility);
+        let b = |buf| buffers.get(buf);
+        let bindings = IndirectBindings {
+            params: b(Buf::MirrorParams),
+            vpls: b(Buf::Vpls),
+            vpl_header: b(Buf::VplHeader),
+            gbuf_position: b(Buf::MirrorPosition),
+            gbuf_normal: b(Buf::MirrorNormal),
+            gbuf_geometric: b(Buf::MirrorGeometric),
+            irradiance_out: b(Buf::MirrorIrradiance),
+        };
+        let list = MirrorListBindings {
+            mirror_list: b(Buf::MirrorList),
+        };
+        FramePass::new(
+            "mirror indirect",
+            self.list_steps(full.0, full.1, shape.interleave, iv, shape.list_grids.0)
+                .to_vec(),
+            bind(device, "indirect", &self.layout, &bindings),
+        )
+        .over(shape.ranges)
+        .with_group3(bind(device, "mirror list", &self.list_layout, &list))
     }
 }

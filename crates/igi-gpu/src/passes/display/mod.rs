@@ -2,8 +2,22 @@
 //! onto a window's surface, and optionally the frame's VPLs drawn as dots. A render pass,
 //! not a compute stage: `igi render` never runs it. See `shaders/display.wgsl`.
 
+use super::bindings::{bind, layout_of, Bindings};
 use crate::layout::DisplayParams;
 use crate::shader::ParamsBinding;
+
+crate::bindings! {
+    /// Bind group 1 of display.wgsl.
+    pub struct DisplayBindings {
+        /// The frame's parameters (the image's size).
+        params: Params,
+        /// How to show it (viewport, exposure, dots).
+        display: Params,
+        color_in: Read,
+        vpls: Read,
+        vpl_header: Read,
+    }
+}
 
 /// What the display reads from the renderer (see `Renderer::display_inputs`).
 pub struct DisplayInputs<'a> {
@@ -39,35 +53,16 @@ pub struct DisplayPass {
     encode_srgb: bool,
 }
 
-fn entry(binding: u32, ty: wgpu::BufferBindingType) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
-        ty: wgpu::BindingType::Buffer {
-            ty,
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    }
-}
-
 impl DisplayPass {
     /// Pipelines drawing into targets of `format`.
     pub fn new(device: &wgpu::Device, format: wgpu::TextureFormat) -> DisplayPass {
-        use wgpu::BufferBindingType::Storage;
-        let read = Storage { read_only: true };
         let params = ParamsBinding::of(device);
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("display"),
-            entries: &[
-                entry(0, params.buffer_type()),
-                entry(1, params.buffer_type()),
-                entry(2, read),
-                entry(3, read),
-                entry(4, read),
-            ],
-        });
+        let layout = layout_of(
+            device,
+            "display",
+            DisplayBindings::BINDINGS,
+            wgpu::ShaderStages::VERTEX_FRAGMENT,
+        );
         let source = super::SOURCES
             .iter()
             .find(|s| s.name == "display")
@@ -139,18 +134,14 @@ impl DisplayPass {
             _pad: [0; 3],
         };
         queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
-        let bind_group = super::bind(
-            device,
-            "display",
-            &self.layout,
-            &[
-                inputs.params,
-                &self.params,
-                inputs.color,
-                inputs.vpls,
-                inputs.vpl_header,
-            ],
-        );
+        let bindings = DisplayBindings {
+            params: inputs.params,
+            display: &self.params,
+            color_in: inputs.color,
+            vpls: inputs.vpls,
+            vpl_header: inputs.vpl_header,
+        };
+        let bind_group = bind(device, "display", &self.layout, &bindings).group;
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("display"),
             color_attachments: &[Some(wgpu::RenderPassColorAttachment {

@@ -1,0 +1,88 @@
+//! The frame's parameter block (`FrameParams`, `layout.rs`) from the settings, the camera
+//! and the scene's lights.
+
+use super::{low_resolution, Renderer};
+use crate::layout::FrameParams;
+use igi_core::settings::{GeometryBound, InterleavePattern, OutputBuffer, RenderSettings};
+
+impl Renderer {
+    /// The parameters of a frame of `paths` light paths from Halton index `base`, the
+    /// `accumulate_index`-th of an accumulation.
+    pub(super) fn frame_params(
+        &self,
+        settings: &RenderSettings,
+        paths: u32,
+        base: u32,
+        accumulate_index: u32,
+    ) -> FrameParams {
+        let a = &settings.accelerations;
+        let low = low_resolution(settings);
+        // Frame 0 through pixel centres (the canonical image); later accumulated frames
+        // at (2, 3) Halton points within the pixel.
+        let jitter = if accumulate_index == 0 {
+            (0.0, 0.0)
+        } else {
+            (
+                igi_core::sampling::radical_inverse(2, accumulate_index) - 0.5,
+                igi_core::sampling::radical_inverse(3, accumulate_index) - 0.5,
+            )
+        };
+        let cam = &self.camera;
+        let (forward, right, up) = cam.basis();
+        let min_dist = settings
+            .min_dist
+            .unwrap_or(igi_core::settings::DEFAULT_MIN_DIST_FRACTION * self.diagonal);
+        FrameParams {
+            cam_eye: cam.eye.to_array(),
+            width: settings.width,
+            cam_forward: forward.to_array(),
+            height: settings.height,
+            cam_right: right.to_array(),
+            tan_half_fov_y: (cam.fov_y_deg.to_radians() * 0.5).tan(),
+            cam_up: up.to_array(),
+            aspect: settings.width as f32 / settings.height as f32,
+            total_power: self.total_power,
+            light_count: self.scene.light_count,
+            path_count: paths,
+            bounces: settings.bounces.max(1),
+            min_dist,
+            geometry_bound: match settings.geometry_bound {
+                GeometryBound::Smoothstep => 0,
+                GeometryBound::Clamp => 1,
+            },
+            mirror_depth: settings.mirror_depth,
+            halton_base: base,
+            output: match settings.output {
+                OutputBuffer::Final => 0,
+                OutputBuffer::Direct => 1,
+                OutputBuffer::Indirect => 2,
+                OutputBuffer::Irradiance => 3,
+                OutputBuffer::Normals => 4,
+                OutputBuffer::Depth => 5,
+            },
+            light_power_sum: self.light_power_sum,
+            low_width: low.0,
+            low_height: low.1,
+            downsample: a.downsample.max(1),
+            interleave_n: a.interleave.0.max(1),
+            interleave_m: a.interleave.1.max(1),
+            pattern: match a.pattern {
+                InterleavePattern::Regular => 0,
+                InterleavePattern::Irregular => 1,
+            },
+            seed: settings.seed,
+            accumulate_index,
+            upsample_sigma: a.upsample_sigma,
+            normal_power: a.upsample_normal_power,
+            upsample_depth: a.upsample_depth as u32,
+            depth_threshold: a.depth_threshold,
+            normal_threshold: a.normal_threshold,
+            jitter_x: jitter.0,
+            jitter_y: jitter.1,
+            count_rays: 0,
+            depth_scale: 1.0 / self.diagonal.max(f32::MIN_POSITIVE),
+            ray_offset_floor: self.ray_offset_floor,
+            _pad: [0; 2],
+        }
+    }
+}
