@@ -14,6 +14,7 @@
 //! [`upsample`]'s gatherer, and this module holds the one helper of `shaders/frame.wgsl`
 //! that several of them use ([`representative_pixel`]).
 
+pub mod compose;
 pub mod filter;
 pub mod upsample;
 
