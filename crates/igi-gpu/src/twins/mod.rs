@@ -16,6 +16,7 @@
 
 pub mod compose;
 pub mod filter;
+pub mod gather;
 pub mod upsample;
 
 use crate::layout::FrameParams;
