@@ -1,7 +1,7 @@
 //! Checks the BVH's shadow-ray answers against an f64 test of every triangle: how many
 //! segments the f32 walk calls occluded that no triangle crosses ("false occlusions"),
 //! and how many it calls free that one does ("missed"). The measurement behind the ray
-//! offset floor (`igi_core::bvh::offset_floor`, docs/PERFORMANCE.md attempt 47).
+//! offset floor (`igi_core::bvh::offset_floor`).
 //!
 //! `cargo run --release -p igi-core --example occlusion_check -- [SCENE.toml] [COUNT] [FLOOR]`
 //! (defaults: the conference room of `shared/scenes`, 3,000 segments of each kind, the

@@ -50,12 +50,11 @@ pub const MAX_DEPTH: u32 = 60;
 
 /// Largest leaf the SAH may choose; larger ranges are always split (unless they reach
 /// [`MAX_DEPTH`]). Small leaves keep the work of neighbouring GPU threads similar, and a
-/// triangle test costs the walks more than its share of the SAH: on the H200 (conference
-/// room, split BVH; docs/PERFORMANCE.md attempt 97) 3 instead of 4 made the random
-/// segments 2.168 -> 2.219 G rays/s, closest hits 1.808 -> 1.897, canonical frames 9.88
-/// -> 9.83 ms, for 6% more nodes and no measurable build time; 2 did about as well on
-/// the rays and slightly worse on the frames, for 24% more nodes and 5% more build time;
-/// 1 was slower everywhere.
+/// triangle test costs the walks more than its share of the SAH. Measured on the H200
+/// (conference room, split BVH): 3 instead of 4 made every ray query and the frames
+/// faster, for a few percent more nodes and no measurable build time; 2 did about as
+/// well on the rays and slightly worse on the frames, for many more nodes and a longer
+/// build; 1 was slower everywhere.
 pub const MAX_LEAF_SIZE: usize = 3;
 
 /// Number of bins per axis for the SAH split search.
@@ -184,12 +183,11 @@ impl BvhNode {
 pub enum BvhBuilder {
     /// Binned SAH over references with early split clipping (the `split` submodule:
     /// Ernst and Greiner 2007): the few long thin triangles whose boxes waste the most
-    /// area are cut into pieces with tighter boxes. On the conference room 17% more
-    /// references and about 1.2 times the build time of `Binned` (attempt 111), and
-    /// every ray query and frame faster on the H200 (docs/PERFORMANCE.md, attempts 77,
-    /// 79 and 80). Every exact query answers as with `Binned` (closest-hit ties between
-    /// triangles at one distance aside); imperfect visibility finds less false
-    /// occlusion. The commands' default.
+    /// area are cut into pieces with tighter boxes. On the conference room about a sixth
+    /// more references and a somewhat longer build than `Binned`, and every ray query
+    /// and frame faster on the H200. Every exact query answers as with `Binned`
+    /// (closest-hit ties between triangles at one distance aside); imperfect visibility
+    /// finds less false occlusion. The commands' default.
     #[default]
     Split,
     /// Binned SAH over whole triangles (the `build` submodule, [`Bvh::build`]): the
@@ -259,7 +257,7 @@ pub struct Bvh {
     /// Three rows per BVH slot, in BVH order (slot i at 3i..3i+3): the x, the y and the z
     /// coordinates of its vertices 0, 1 and 2 (w = 0). The triangle test reads the rows of
     /// the ray's Woop axes (kx, ky, kz) by index; stored as vertices, the coordinates had
-    /// to be permuted with 18 selects a test (docs/PERFORMANCE.md attempt 102).
+    /// to be permuted with 18 selects a test.
     pub tri_rows: Vec<TriRow>,
     /// BVH slot -> index of the triangle in the slice given to the build. Each triangle
     /// has one slot, or more with [`BvhBuilder::Split`] (one per piece).

@@ -1,12 +1,18 @@
 //! The scene as the renderer sees it: flat triangles with materials, point lights and a
 //! pinhole camera (paper section 4: the paper's only light type is the point light).
 //!
-//! Loading lives in [`loader`] (the TOML contract and OBJ/MTL), the built-in Cornell box
+//! Loading lives in [`loader`] (the TOML contract and OBJ/MTL, with private modules by
+//! format: `toml_file` for the scene file's schema and checks, `obj`, `mtl`, and `error`
+//! for [`SceneError`] and its message helpers) and [`gltf`], the built-in Cornell box
 //! in [`builtin`].
 
 pub mod builtin;
+mod error;
 pub mod gltf;
 pub mod loader;
+mod mtl;
+mod obj;
+mod toml_file;
 
 use glam::{Vec3, Vec3A};
 use std::path::PathBuf;
@@ -131,8 +137,8 @@ pub fn scale_pow2(e: Vec3A) -> Vec3A {
 ///
 /// In `Vec3A`, whose fourth lane glam keeps a copy of z, and not `Vec3`: LLVM vectorised
 /// the `Vec3` arithmetic with fourth lanes left undefined, whose products were often
-/// subnormal, and each cost a microcode assist: 100-115 ns a triangle on the 2-core
-/// machine against 13 with subnormals flushed, 30 ms of loading the conference room.
+/// subnormal, and each cost a microcode assist, which made the normals several times
+/// slower and a visible share of loading a large scene.
 /// The results are the same bit for bit (the same products and sums in the same order;
 /// the tests compare with the plain formula).
 pub fn geometric_normal(v: &[Vec3; 3]) -> Option<Vec3> {

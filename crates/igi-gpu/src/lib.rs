@@ -16,6 +16,7 @@ pub mod raybench;
 pub mod scene_buffers;
 pub mod shader;
 pub mod switches;
+pub mod twins;
 
 pub use context::{AdapterChoice, GpuContext, GpuError};
 pub use frame::{FrameOutput, Passes, Renderer};

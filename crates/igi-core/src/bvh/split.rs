@@ -19,8 +19,7 @@
 //! piece's box, and the triangle test (on the whole triangle) decides as before.
 //! Imperfect visibility (section 4.1 of the paper) does see a difference: it still tests
 //! the whole triangle's box, but a segment reaches that test only through a leaf whose
-//! piece box it enters, so it finds less false occlusion (docs/PERFORMANCE.md, attempts
-//! 77 and 79).
+//! piece box it enters, so it finds less false occlusion.
 
 use glam::{Vec3, Vec3A};
 
@@ -30,18 +29,18 @@ use super::{Bvh, BvhBuilder};
 
 /// A triangle's reference is split while its box's half area exceeds this many times
 /// the area of the triangle's part in it. With [`SPLIT_DEPTH`], the best of the ratio
-/// and depth pairs measured on the H200 (4/2, 8/3, 4/3, 16/4 in docs/PERFORMANCE.md
-/// attempt 77; with [`SPLIT_MIN_WASTE`], 4/2 against 4/3 and 4/4 in attempt 79).
+/// and depth pairs measured on the H200 (4/2, 8/3, 4/3 and 16/4; with
+/// [`SPLIT_MIN_WASTE`], 4/2 against 4/3 and 4/4).
 pub const SPLIT_RATIO: f32 = 4.0;
 
 /// At most this many halvings per triangle: up to 2^SPLIT_DEPTH references.
 pub const SPLIT_DEPTH: u32 = 2;
 
 /// Only a box that wastes more than this fraction of the scene box's half area is cut:
-/// small slivers are many and cost rays little. On the conference room, 323,506
-/// references (+17%) instead of 566,924 with the ratio alone, and every GPU figure
-/// better (docs/PERFORMANCE.md attempt 79); relative to the scene's box, so that the
-/// cut does not depend on the scene's units.
+/// small slivers are many and cost rays little. On the conference room this cuts far
+/// fewer references than the ratio alone (about a sixth more than whole triangles
+/// instead of three quarters), and every GPU figure was better; relative to the scene's
+/// box, so that the cut does not depend on the scene's units.
 pub const SPLIT_MIN_WASTE: f32 = 1e-6;
 
 /// Outward padding of a piece's box, relative to the triangle's largest coordinate on

@@ -99,7 +99,7 @@ fn check_structure_of(bvh: &Bvh, tris: &[[Vec3; 3]], builder: BvhBuilder) {
         node_seen[node as usize] = true;
         let nd = bvh.nodes[node as usize];
         // Any-hit walks visit child a first: the one of larger triangle area per unit of
-        // the interior nodes' SAH cost below it (attempt 84).
+        // the interior nodes' SAH cost below it (see `occluder_first` in build/layout.rs).
         let ((area_a, cost_a), (area_b, cost_b)) = (content(bvh, &nd.a()), content(bvh, &nd.b()));
         assert!(
             area_a * cost_b >= area_b * cost_a,
@@ -726,7 +726,7 @@ fn segments_ending_on_a_huge_floor_are_not_occluded_by_it() {
     );
     let up = Vec3::Y;
     // Ends of the two segments the CPU check of the conference room found occluded by
-    // the floor (docs/PERFORMANCE.md attempt 47): at the origin, and at the far end.
+    // the floor before the offset floor existed: at the origin, and at the far end.
     let x = Vec3::new(676.25275, y, 182.99976);
     let d = Vec3::new(-0.85514784, 0.4653153, 0.22848178);
     let mut pairs = vec![(x, up, x + 1400.8771 * d, -d)];

@@ -2,7 +2,8 @@
 //! build that replaces OptiX's acceleration structure in Marques and Santos' system, run
 //! several times in one process, with what a reader needs to compare two figures (the
 //! phases, the threads, the page faults of the first build, a hash of the tree). The
-//! build target of docs/PERFORMANCE.md is measured with it (`scripts/build-bench.sh`).
+//! build figures of the lab log (docs/lab/PERFORMANCE.md) are measured with it
+//! (`scripts/build-bench.sh`).
 
 use std::fmt;
 use std::time::Instant;
@@ -23,7 +24,7 @@ pub struct BuildTiming {
     /// several builds), less sensitive than wall time to other processes.
     pub cpu_ms_per_build: Option<f64>,
     /// Minor page faults of the first build (Linux): what a build in a new process pays
-    /// for fresh memory (docs/PERFORMANCE.md attempts 113 and 128).
+    /// for fresh memory, a large share of its time.
     pub first_build_faults: Option<u64>,
     /// The last build's tree.
     pub bvh: Bvh,

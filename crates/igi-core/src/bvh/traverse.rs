@@ -30,8 +30,8 @@ pub const NO_HIT: u32 = 0xffff_ffff;
 /// scene's extent and its length unbounded; outside it the box is missed, or visited for nothing when the origin
 /// lies within 1e-23 of the widened slab (conservative). This costs the slab test
 /// nothing per box; the select that replaced exit distances >= 0 of parallel axes by a
-/// large value did, 6-10% of every walk (docs/PERFORMANCE.md attempt 35). Boxes only get
-/// wider along parallel axes, so the answers stay those of the exact test. No NaN or
+/// large value did, a measurable share of every walk. Boxes only get wider along
+/// parallel axes, so the answers stay those of the exact test. No NaN or
 /// infinity arises from finite data (coordinates up to ~1e7); the only infinities are
 /// those of the empty child's point box at +inf, whose distances are +-inf and only make
 /// it miss.
@@ -49,7 +49,7 @@ pub(crate) const PARALLEL_SLACK: f32 = 1.0 / 1_048_576.0;
 /// [`box_span`] computes the distance to a plane b of axis k as one fused multiply-add,
 /// t = fma(b, inv_k, c) with c = -o_k inv_k precomputed per ray, instead of
 /// (b - o_k) inv_k: a subtraction fewer for each of a box's six planes (the walks are
-/// bound by the arithmetic of their box tests; docs/PERFORMANCE.md attempt 93). The
+/// bound by the arithmetic of their box tests). The
 /// exact (b - o_k) inv_k needs no absolute error bound, since b - o_k is exact where b
 /// and o_k are close (Sterbenz). The fma form carries absolute errors that do not shrink
 /// with t: the rounding of o_k inv_k and of c's pad, each at most 2^-24 |o_k inv_k|, and
@@ -90,7 +90,7 @@ pub(crate) const BOX_TFAR_SCALE: f32 = 1.0 + 3.0 * f32::EPSILON;
 /// answer what the triangle tests answer. It does not hold for long rays (a ray of tmax
 /// 3.4e38 would need a pad that opens every box), which keep the scale ([`trace_any`]).
 /// The renderer's shadow rays are all segments (`shadow_segment`); their walk made
-/// canonical frames 1.2-1.4% faster on the H200 (docs/PERFORMANCE.md attempt 104).
+/// canonical frames faster on the H200.
 pub(crate) const SEGMENT_PAD: f32 = 1.0 / 2_097_152.0;
 
 /// Wächter-Binder offset: distance below which coordinates get an absolute offset.
@@ -213,7 +213,7 @@ impl TraceRay {
 /// when entry <= exit. Each axis enters at the nearer of its two planes and leaves at the
 /// farther (min and max of the two distances; with a choice by the direction's sign
 /// instead, the NVIDIA driver spilled 12 bytes a thread of the GPU's gather to shared
-/// memory and the gathers ran 3.5% slower, docs/PERFORMANCE.md attempt 81). So the child
+/// memory and the gathers ran slower). So the child
 /// no ray may hit is a point box at +inf ([`super::BvhChild::EMPTY`]), not an inverted
 /// one, and the walks' tmax is finite ([`finite_tmax`]). Each plane's distance is one
 /// fused multiply-add with the ray's padded offsets (see [`SLAB_PAD`]). Parallel axes
@@ -222,8 +222,8 @@ impl TraceRay {
 /// whose planes are padded instead ([`SEGMENT_PAD`]).
 ///
 /// The minima and maxima are taken on the distances' bits read as signed integers (the
-/// GPU's integer minimum and maximum made the walks 1-6% faster on the H200 than float
-/// ones, docs/PERFORMANCE.md attempt 104). Non-negative floats order like their bits;
+/// GPU's integer minimum and maximum made the walks faster on the H200 than float
+/// ones). Non-negative floats order like their bits;
 /// negative ones come below all of them, in reverse order among themselves, and -0 is
 /// the lowest of all. The reverse order never changes an answer: an axis whose two
 /// distances are both negative gives the entry a negative candidate, which the clamp to
@@ -460,9 +460,8 @@ pub(crate) fn trace_closest(bvh: &Bvh, origin: Vec3, dir: Vec3, tmax: f32) -> Op
 }
 
 /// Any hit: the walk of [`trace_closest`] without pruning and in fixed child order (a,
-/// then b: the nearer-first order made the GPU's frames 4-7% slower, docs/PERFORMANCE.md
-/// attempt 31; the builder makes a the likelier occluder per unit of work, attempts 80
-/// and 84),
+/// then b: the nearer-first order made the GPU's frames slower; the builder makes a the
+/// likelier occluder per unit of work),
 /// returning at the first triangle hit with 0 < t < tmax. For rays of any length: the
 /// far ends are scaled by [`BOX_TFAR_SCALE`].
 pub(crate) fn trace_any(bvh: &Bvh, origin: Vec3, dir: Vec3, tmax: f32) -> bool {
@@ -616,8 +615,8 @@ pub fn brute_force_any(triangles: &[[Vec3; 3]], origin: Vec3, dir: Vec3, tmax: f
 /// whose coordinates are small while its surface is huge (the conference room's floor:
 /// two triangles 2,600 units wide at y = -1.57) was moved 3e-5 off a plane that a test
 /// from across the room places with an error of ~1e-4: a CPU check against an f64 test
-/// found 2.3% of a frame's VPL shadow rays occluded by the surface at one of their ends
-/// (docs/PERFORMANCE.md attempt 47), none with the floor.
+/// found a few percent of a frame's VPL shadow rays occluded by the surface at one of
+/// their ends, none with the floor.
 pub fn offset_ray_origin(p: Vec3, n: Vec3, floor: f32) -> Vec3 {
     let f = |p: f32, n: f32| {
         if p.abs() < OFFSET_ORIGIN {

@@ -1,0 +1,246 @@
+//! The loader's error type, [`SceneError`], with the [`Location`] it names, and the helpers
+//! that keep its messages on one line (quoting file contents and paths), plus the reading
+//! of a file's bytes as text, whose failures are errors of this kind.
+
+use std::borrow::Cow;
+use std::io;
+use std::path::PathBuf;
+
+/// Where in which file an error is: `file`, `file:line` or `file:line:column` (1-based).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Location {
+    pub file: String,
+    pub line: Option<usize>,
+    pub column: Option<usize>,
+}
+
+impl Location {
+    pub(super) fn file(file: &str) -> Self {
+        Location {
+            file: one_line(file),
+            line: None,
+            column: None,
+        }
+    }
+
+    pub(super) fn line(file: &str, line: usize) -> Self {
+        Location {
+            line: Some(line),
+            ..Location::file(file)
+        }
+    }
+
+    /// The line and column (in characters) of byte `offset` of `text`.
+    pub(super) fn offset(file: &str, text: &str, offset: usize) -> Self {
+        let mut offset = offset.min(text.len());
+        while !text.is_char_boundary(offset) {
+            offset -= 1;
+        }
+        let before = &text[..offset];
+        let line = before.matches('\n').count() + 1;
+        let line_start = before.rfind('\n').map_or(0, |i| i + 1);
+        Location {
+            line: Some(line),
+            column: Some(before[line_start..].chars().count() + 1),
+            ..Location::file(file)
+        }
+    }
+}
+
+impl std::fmt::Display for Location {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.file)?;
+        if let Some(line) = self.line {
+            write!(f, ":{line}")?;
+            if let Some(column) = self.column {
+                write!(f, ":{column}")?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Why a scene could not be loaded. Its `Display` is one line naming the file.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    /// A file could not be read: missing, unreadable, a directory.
+    #[error("cannot read {what} '{}'{}: {}", one_line(&.path.display().to_string()), context_suffix(.context), io_message(.error))]
+    Read {
+        /// "scene file", "mesh" or "material library".
+        what: &'static str,
+        path: PathBuf,
+        /// Who referenced the file, e.g. "referenced by scene.toml".
+        context: Option<String>,
+        /// The cause, whose message the error's own includes (so it is not also its
+        /// `source()`, which would print it twice in a chain of causes).
+        error: io::Error,
+    },
+    /// The file is not well-formed: TOML syntax or types, OBJ or MTL syntax, not text.
+    #[error("{at}: {message}")]
+    Parse { at: Location, message: String },
+    /// The file is well-formed but describes no valid scene (a value out of range, a
+    /// material defined nowhere, no lights, ...).
+    #[error("{at}: {message}")]
+    Invalid { at: Location, message: String },
+}
+
+impl SceneError {
+    pub(super) fn parse(at: Location, message: impl AsRef<str>) -> Self {
+        SceneError::Parse {
+            at,
+            message: one_line(message.as_ref()),
+        }
+    }
+
+    pub(super) fn invalid(at: Location, message: impl AsRef<str>) -> Self {
+        SceneError::Invalid {
+            at,
+            message: one_line(message.as_ref()),
+        }
+    }
+
+    /// Where the error is, when it is in a file's content.
+    pub fn location(&self) -> Option<&Location> {
+        match self {
+            SceneError::Read { .. } => None,
+            SceneError::Parse { at, .. } | SceneError::Invalid { at, .. } => Some(at),
+        }
+    }
+}
+
+pub(super) fn context_suffix(context: &Option<String>) -> String {
+    match context {
+        Some(c) => format!(" ({})", one_line(c)),
+        None => String::new(),
+    }
+}
+
+/// The OS message without its " (os error 2)" tail: "No such file or directory".
+pub(super) fn io_message(e: &io::Error) -> String {
+    one_line(without_os_error_code(&e.to_string()))
+}
+
+/// `text` without the " (os error 2)" tail that Rust adds to an OS error's message (the
+/// message says it in words); the `igi` command drops it from every error it prints.
+pub fn without_os_error_code(text: &str) -> &str {
+    match text.rfind(" (os error ") {
+        Some(i) if text.ends_with(')') => &text[..i],
+        _ => text,
+    }
+}
+
+/// Messages quote file contents and paths: keep them on one line.
+pub(super) fn one_line(s: &str) -> String {
+    s.chars()
+        .map(|c| if c.is_control() { ' ' } else { c })
+        .collect()
+}
+
+/// A line of a file, shortened for a message.
+pub(super) fn excerpt(line: &str) -> String {
+    const MAX: usize = 60;
+    let line = line.trim();
+    match line.char_indices().nth(MAX) {
+        Some((i, _)) => format!("{}...", one_line(&line[..i])),
+        None => one_line(line),
+    }
+}
+
+pub(super) fn fmt3(v: [f32; 3]) -> String {
+    format!("[{}, {}, {}]", v[0], v[1], v[2])
+}
+
+pub(super) const CHANNELS: [&str; 3] = ["red", "green", "blue"];
+
+/// The line (1-based) of byte `offset`.
+pub(super) fn line_at(bytes: &[u8], offset: usize) -> usize {
+    bytes[..offset.min(bytes.len())]
+        .iter()
+        .filter(|&&b| b == b'\n')
+        .count()
+        + 1
+}
+
+/// The TOML file as text (TOML must be UTF-8), or an error naming the line of the first
+/// byte that is not UTF-8.
+pub(super) fn as_text<'a>(bytes: &'a [u8], file: &str) -> Result<&'a str, SceneError> {
+    match std::str::from_utf8(bytes) {
+        Ok(text) => Ok(text.strip_prefix('\u{feff}').unwrap_or(text)),
+        Err(e) => {
+            let at = e.valid_up_to();
+            Err(SceneError::parse(
+                Location::line(file, line_at(bytes, at)),
+                format!(
+                    "not a text file: byte 0x{:02x} at offset {at} is not UTF-8",
+                    bytes.get(at).copied().unwrap_or(0)
+                ),
+            ))
+        }
+    }
+}
+
+/// An OBJ or MTL file as text. A NUL byte means binary data: an error. Other bytes that
+/// are not UTF-8 (a Latin-1 comment or material name, say) are replaced by U+FFFD with a
+/// warning, as the reference converter reads these files (`errors="replace"`).
+pub(super) fn as_lenient_text<'a>(bytes: &'a [u8], file: &str) -> Result<Cow<'a, str>, SceneError> {
+    // `contains` searches bytes with memchr, many at a time, several times faster than a
+    // byte loop over a large mesh; the offset is only wanted for the error.
+    if bytes.contains(&0) {
+        let at = bytes.iter().position(|&b| b == 0).unwrap_or(0);
+        return Err(SceneError::parse(
+            Location::line(file, line_at(bytes, at)),
+            format!("not a text file: a NUL byte at offset {at} (binary data?)"),
+        ));
+    }
+    let text = match std::str::from_utf8(bytes) {
+        Ok(text) => Cow::Borrowed(text),
+        Err(e) => {
+            log::warn!(
+                "{file}:{}: bytes that are not UTF-8 replaced by U+FFFD",
+                line_at(bytes, e.valid_up_to())
+            );
+            String::from_utf8_lossy(bytes)
+        }
+    };
+    Ok(match text {
+        Cow::Borrowed(t) => Cow::Borrowed(t.strip_prefix('\u{feff}').unwrap_or(t)),
+        Cow::Owned(t) => match t.strip_prefix('\u{feff}') {
+            Some(rest) => Cow::Owned(rest.to_string()),
+            None => Cow::Owned(t),
+        },
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn location_of_an_offset_counts_lines_and_characters() {
+        let text = "a = 1\nbé = [1, 2]\n";
+        let at = Location::offset("s.toml", text, text.find('[').unwrap());
+        assert_eq!(at.to_string(), "s.toml:2:6");
+        assert_eq!(
+            Location::offset("s.toml", text, 0).to_string(),
+            "s.toml:1:1"
+        );
+        // Past the end and inside a character: clamped, no panic.
+        assert_eq!(Location::offset("s.toml", text, 999).line, Some(3));
+        assert_eq!(
+            Location::offset("s.toml", text, 8).to_string(),
+            "s.toml:2:2"
+        );
+        assert_eq!(Location::file("x.obj").to_string(), "x.obj");
+        assert_eq!(Location::line("x.obj", 7).to_string(), "x.obj:7");
+    }
+
+    #[test]
+    fn messages_are_one_line() {
+        assert_eq!(one_line("a\nb\r\tc"), "a b  c");
+        let e = io::Error::from_raw_os_error(2);
+        assert_eq!(io_message(&e), "No such file or directory");
+        assert_eq!(excerpt(&"x".repeat(100)).len(), 63);
+        let e = SceneError::invalid(Location::file("f\ng"), "two\nlines");
+        assert_eq!(e.to_string(), "f g: two lines");
+    }
+}

@@ -1,0 +1,190 @@
+//! The glTF document: parsing the JSON or GLB (with the checks that keep the gltf crate
+//! from panicking), the whole read of one file, and the warnings reported once per file.
+
+use std::collections::HashMap;
+use std::path::Path;
+
+use ::gltf::Semantic;
+
+use super::accessors::Reader;
+use super::messages::{document_error, invalid, parse};
+use super::GltfMesh;
+use crate::scene::loader::SceneError;
+
+/// Decodes `%XX` escapes of a relative URI. `None` when the result is not UTF-8 (the gltf
+/// crate would panic on such a URI, so it never sees one).
+pub(super) fn percent_decode(uri: &str) -> Option<String> {
+    let b = uri.as_bytes();
+    let mut out = Vec::with_capacity(b.len());
+    let mut i = 0;
+    while i < b.len() {
+        let hex = |c: u8| (c as char).to_digit(16);
+        if b[i] == b'%' && i + 2 < b.len() {
+            if let (Some(h), Some(l)) = (hex(b[i + 1]), hex(b[i + 2])) {
+                out.push((h * 16 + l) as u8);
+                i += 3;
+                continue;
+            }
+        }
+        out.push(b[i]);
+        i += 1;
+    }
+    String::from_utf8(out).ok()
+}
+
+/// The document, with the checks that keep the gltf crate from panicking on it.
+pub(super) fn document(bytes: &[u8], file: &str) -> Result<::gltf::Gltf, SceneError> {
+    let is_glb = bytes.starts_with(b"glTF");
+    if is_glb {
+        // The crate subtracts 12 from the header's length field unchecked.
+        if bytes.len() < 12 {
+            return Err(parse(
+                file,
+                format!(
+                    "not a valid GLB (binary glTF) file: {} bytes, shorter than the 12-byte header",
+                    bytes.len()
+                ),
+            ));
+        }
+        let length = u32::from_le_bytes([bytes[8], bytes[9], bytes[10], bytes[11]]);
+        if length < 12 {
+            return Err(parse(
+                file,
+                format!("not a valid GLB (binary glTF) file: the header's length {length} is less than 12"),
+            ));
+        }
+    }
+    let raw = ::gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| {
+        let e = document_error(e, file, is_glb);
+        // A `.glb` that is neither GLB nor JSON: say that the magic is missing.
+        let ext_glb = file.to_ascii_lowercase().ends_with(".glb");
+        match e {
+            SceneError::Parse { at, message } if ext_glb && !is_glb => SceneError::Parse {
+                at,
+                message: format!(
+                    "no GLB header (the file does not start with 'glTF') and {message}"
+                ),
+            },
+            e => e,
+        }
+    })?;
+    let ::gltf::Gltf { document, blob } = raw;
+    let root = document.into_json();
+    // gltf 1.4's validation reads `accessors[POSITION]` with `[]`: check that index first.
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, prim) in mesh.primitives.iter().enumerate() {
+            let key = ::gltf::json::validation::Checked::Valid(Semantic::Positions);
+            if let Some(index) = prim.attributes.get(&key) {
+                if index.value() >= root.accessors.len() {
+                    return Err(parse(
+                        file,
+                        format!(
+                            "invalid glTF: meshes[{m}].primitives[{p}].attributes.POSITION = {}: index out of bounds (the file has {} accessors)",
+                            index.value(),
+                            root.accessors.len()
+                        ),
+                    ));
+                }
+            }
+        }
+    }
+    let document =
+        ::gltf::Document::from_json(root).map_err(|e| document_error(e, file, is_glb))?;
+    Ok(::gltf::Gltf { document, blob })
+}
+
+pub(super) fn read(bytes: &[u8], path: &Path, file: &str) -> Result<GltfMesh, SceneError> {
+    let ::gltf::Gltf { document, blob } = document(bytes, file)?;
+    let mut r = Reader {
+        file: file.to_string(),
+        dir: path.parent().unwrap_or(Path::new("")).to_path_buf(),
+        stem: path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default(),
+        buffers: Vec::new(),
+        out: GltfMesh::default(),
+        materials: HashMap::new(),
+        textures: HashMap::new(),
+        bad_images: image_problems(&document),
+        warn: Warnings::default(),
+    };
+    r.load_buffers(&document, blob)?;
+    let Some(scene) = document
+        .default_scene()
+        .or_else(|| document.scenes().next())
+    else {
+        return Err(invalid(file, "the glTF file has no scene to render"));
+    };
+    r.scene(&document, &scene)?;
+    r.warn.log(file);
+    Ok(r.out)
+}
+
+/// Images that `Image::source()` of gltf 1.4 would `unwrap()` a `None` of: it assumes a
+/// `uri` when there is no `bufferView`, and a `mimeType` when there is one (a fuzzing find).
+pub(super) fn image_problems(doc: &::gltf::Document) -> HashMap<usize, &'static str> {
+    let images = doc.as_json().images.iter().enumerate();
+    images
+        .filter_map(
+            |(i, img)| match (&img.buffer_view, &img.uri, &img.mime_type) {
+                (None, None, _) => Some((i, "the image has neither uri nor bufferView")),
+                (Some(_), _, None) => Some((i, "the image has a bufferView but no mimeType")),
+                _ => None,
+            },
+        )
+        .collect()
+}
+
+/// Things skipped or repaired, reported once per file.
+#[derive(Default)]
+pub(super) struct Warnings {
+    /// Primitives of mode POINTS, LINES, LINE_LOOP, LINE_STRIP.
+    pub(super) not_triangles: usize,
+    /// Index counts of TRIANGLES primitives that are not a multiple of 3.
+    pub(super) leftover_indices: usize,
+    pub(super) degenerate: usize,
+    pub(super) bad_normals: usize,
+    /// Spot and directional lights.
+    pub(super) lights_skipped: usize,
+    pub(super) emissive: usize,
+    pub(super) skinned_or_morphed: usize,
+}
+
+impl Warnings {
+    pub(super) fn log(&self, file: &str) {
+        let w = |n: usize, what: &str| {
+            if n > 0 {
+                log::warn!("{file}: {n} {what}");
+            }
+        };
+        w(
+            self.not_triangles,
+            "primitives of mode POINTS or LINES* skipped (only triangles are rendered)",
+        );
+        w(
+            self.leftover_indices,
+            "TRIANGLES primitives whose index count is not a multiple of 3 (the last indices ignored)",
+        );
+        w(
+            self.degenerate,
+            "degenerate triangles (zero area, or a vertex made non-finite by its node transform) dropped",
+        );
+        w(
+            self.bad_normals,
+            "NORMAL values of zero length or not finite replaced by the geometric normal",
+        );
+        w(
+            self.lights_skipped,
+            "spot or directional lights skipped (the only light type is the point light)",
+        );
+        w(
+            self.emissive,
+            "materials with an emissive colour: emission ignored (surfaces do not emit)",
+        );
+        w(
+            self.skinned_or_morphed,
+            "skinned or morphed meshes: skins and morph targets ignored (the mesh as stored)",
+        );
+    }
+}

@@ -1,0 +1,272 @@
+//! The scene's node trees under their world matrices: the KHR_lights_punctual point
+//! lights at their nodes and each mesh primitive's triangles.
+
+use ::gltf::accessor::{DataType, Dimensions};
+use ::gltf::khr_lights_punctual::Kind as LightKind;
+use ::gltf::mesh::Mode;
+use ::gltf::Semantic;
+use glam::{Mat3, Mat4, Vec3};
+
+use super::accessors::Reader;
+use super::messages::{fmt3, invalid, mesh_label, parse};
+use super::LUMENS_PER_WATT;
+use crate::scene::loader::SceneError;
+use crate::scene::{PointLight, Triangle};
+
+impl Reader {
+    /// Walks the scene's node trees depth-first, each node's world matrix the product of
+    /// the local ones from its root down.
+    pub(super) fn scene(
+        &mut self,
+        doc: &::gltf::Document,
+        scene: &::gltf::Scene,
+    ) -> Result<(), SceneError> {
+        // An explicit stack (no recursion, so a deep file cannot overflow ours) and a
+        // visited mark (the crate does not reject cycles, which would never end).
+        let mut seen = vec![false; doc.nodes().len()];
+        let mut stack: Vec<(::gltf::Node, Mat4)> = scene
+            .nodes()
+            .map(|n| (n, Mat4::IDENTITY))
+            .collect::<Vec<_>>();
+        stack.reverse();
+        while let Some((node, parent)) = stack.pop() {
+            let i = node.index();
+            if std::mem::replace(&mut seen[i], true) {
+                return Err(parse(
+                    &self.file,
+                    format!(
+                        "node {i} is reached twice from scene {} (a cycle, or a node with two parents): the node hierarchy must be a tree",
+                        scene.index()
+                    ),
+                ));
+            }
+            let local = Mat4::from_cols_array_2d(&node.transform().matrix());
+            let world = parent * local;
+            if !world.is_finite() {
+                return Err(invalid(
+                    &self.file,
+                    format!("node {i}: its transform (or a parent's) is not finite"),
+                ));
+            }
+            if let Some(mesh) = node.mesh() {
+                if node.skin().is_some() || mesh.primitives().any(|p| p.morph_targets().len() > 0) {
+                    self.warn.skinned_or_morphed += 1;
+                }
+                for prim in mesh.primitives() {
+                    self.primitive(&mesh, &prim, &world)?;
+                }
+            }
+            if let Some(light) = node.light() {
+                self.light(&light, i, &world)?;
+            }
+            let children: Vec<_> = node.children().collect();
+            stack.extend(children.into_iter().rev().map(|c| (c, world)));
+        }
+        Ok(())
+    }
+
+    /// A KHR_lights_punctual light at node `node`.
+    pub(super) fn light(
+        &mut self,
+        light: &::gltf::khr_lights_punctual::Light,
+        node: usize,
+        world: &Mat4,
+    ) -> Result<(), SceneError> {
+        if !matches!(light.kind(), LightKind::Point) {
+            self.warn.lights_skipped += 1;
+            return Ok(());
+        }
+        let color = light.color();
+        let intensity = light.intensity();
+        let valid = intensity.is_finite()
+            && intensity >= 0.0
+            && color.iter().all(|c| c.is_finite() && *c >= 0.0);
+        if !valid {
+            return Err(invalid(
+                &self.file,
+                format!(
+                    "light {} (node {node}): color {} and intensity {intensity} must be finite numbers >= 0",
+                    light.index(),
+                    fmt3(color)
+                ),
+            ));
+        }
+        // Candela is lm/sr; at 683 lm/W it is 1/683 W/sr. The range cut-off is ignored:
+        // the renderer's point lights fall off with the inverse square only.
+        self.out.lights.push(PointLight {
+            position: world.w_axis.truncate(),
+            intensity: Vec3::from(color) * (intensity / LUMENS_PER_WATT),
+        });
+        Ok(())
+    }
+
+    /// One primitive of `mesh` under the world matrix `world`: appends its triangles.
+    pub(super) fn primitive(
+        &mut self,
+        mesh: &::gltf::Mesh,
+        prim: &::gltf::Primitive,
+        world: &Mat4,
+    ) -> Result<(), SceneError> {
+        let what = format!("{} primitive {}", mesh_label(mesh), prim.index());
+        let mode = prim.mode();
+        if !matches!(
+            mode,
+            Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
+        ) {
+            self.warn.not_triangles += 1;
+            return Ok(());
+        }
+        let Some(pos_acc) = prim.get(&Semantic::Positions) else {
+            return Err(parse(&self.file, format!("{what} has no POSITION")));
+        };
+        self.check_accessor(
+            &pos_acc,
+            &format!("{what} POSITION"),
+            &[DataType::F32],
+            Dimensions::Vec3,
+        )?;
+        let nrm_acc = prim.get(&Semantic::Normals);
+        if let Some(acc) = &nrm_acc {
+            self.check_accessor(
+                acc,
+                &format!("{what} NORMAL"),
+                &[DataType::F32],
+                Dimensions::Vec3,
+            )?;
+            if acc.count() != pos_acc.count() {
+                return Err(parse(
+                    &self.file,
+                    format!(
+                        "{what}: NORMAL has {} elements but POSITION has {}",
+                        acc.count(),
+                        pos_acc.count()
+                    ),
+                ));
+            }
+        }
+        if let Some(acc) = prim.indices() {
+            self.check_accessor(
+                &acc,
+                &format!("{what} indices"),
+                &[DataType::U8, DataType::U16, DataType::U32],
+                Dimensions::Scalar,
+            )?;
+        }
+
+        let buffers = &self.buffers;
+        let reader = prim.reader(|b| buffers.get(b.index()).map(|d| d.0.as_slice()));
+        let internal = |of: &str| {
+            parse(
+                &self.file,
+                format!("{what}: internal error: cannot read the {of} accessor"),
+            )
+        };
+        let positions: Vec<Vec3> = reader
+            .read_positions()
+            .ok_or_else(|| internal("POSITION"))?
+            .map(Vec3::from)
+            .collect();
+        let normals: Option<Vec<Vec3>> = match &nrm_acc {
+            Some(_) => Some(
+                reader
+                    .read_normals()
+                    .ok_or_else(|| internal("NORMAL"))?
+                    .map(Vec3::from)
+                    .collect(),
+            ),
+            None => None,
+        };
+        let indices: Vec<u32> = match prim.indices() {
+            Some(_) => reader
+                .read_indices()
+                .ok_or_else(|| internal("indices"))?
+                .into_u32()
+                .collect(),
+            None => (0..positions.len() as u32).collect(),
+        };
+        let nv = positions.len();
+        if let Some((k, &i)) = indices.iter().enumerate().find(|(_, &i)| i as usize >= nv) {
+            return Err(parse(
+                &self.file,
+                format!("{what}: index {i} (element {k} of the indices) out of range: POSITION has {nv} vertices"),
+            ));
+        }
+
+        let corners = triangulate(mode, &indices);
+        if mode == Mode::Triangles && !indices.len().is_multiple_of(3) {
+            self.warn.leftover_indices += 1;
+        }
+        let material = self.material(prim.material())?;
+
+        // Normals go through the cofactor matrix, det * M^-T: defined even when M is
+        // singular, and with the sign of det undone it is the inverse transpose's direction.
+        let m3 = Mat3::from_mat4(*world);
+        let det = m3.determinant();
+        let mirrored = det < 0.0;
+        let (c0, c1, c2) = (m3.x_axis, m3.y_axis, m3.z_axis);
+        let mut normal_matrix = Mat3::from_cols(c1.cross(c2), c2.cross(c0), c0.cross(c1));
+        if mirrored {
+            normal_matrix = -normal_matrix;
+        }
+
+        let mut count = 0usize;
+        for mut t in corners {
+            if mirrored {
+                // The glTF spec: a negative determinant makes front faces clockwise; keep
+                // the geometric normal on the side of the (inverse transposed) normals.
+                t.swap(1, 2);
+            }
+            let local = t.map(|i| positions[i as usize]);
+            if let Some(k) = (0..3).find(|&k| !local[k].is_finite()) {
+                return Err(invalid(
+                    &self.file,
+                    format!(
+                        "{what}: a triangle uses vertex {} whose position {} is not finite",
+                        t[k],
+                        fmt3(local[k].into())
+                    ),
+                ));
+            }
+            let v = local.map(|p| world.transform_point3(p));
+            // A world transform may still make a vertex non-finite: then it is dropped too.
+            let Some(ng) = crate::scene::geometric_normal(&v) else {
+                self.warn.degenerate += 1;
+                continue;
+            };
+            let mut n = [ng; 3];
+            if let Some(normals) = &normals {
+                for (k, nk) in n.iter_mut().enumerate() {
+                    match (normal_matrix * normals[t[k] as usize]).try_normalize() {
+                        Some(x) => *nk = x,
+                        None => self.warn.bad_normals += 1,
+                    }
+                }
+            }
+            self.out.triangles.push(Triangle {
+                v,
+                n,
+                material: material as u32,
+            });
+            count += 1;
+        }
+        self.out.materials[material].triangles += count;
+        Ok(())
+    }
+}
+
+/// The triangles of a primitive's vertex list, per the glTF spec: TRIANGLES in threes
+/// (a remainder ignored), TRIANGLE_STRIP `{i, i + 1 + i % 2, i + 2 - i % 2}` (every
+/// triangle counter-clockwise), TRIANGLE_FAN `{i + 1, i + 2, 0}`.
+pub(super) fn triangulate(mode: Mode, idx: &[u32]) -> Vec<[u32; 3]> {
+    let n = idx.len();
+    match mode {
+        Mode::Triangles => idx.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
+        Mode::TriangleStrip => (0..n.saturating_sub(2))
+            .map(|i| [idx[i], idx[i + 1 + i % 2], idx[i + 2 - i % 2]])
+            .collect(),
+        Mode::TriangleFan => (0..n.saturating_sub(2))
+            .map(|i| [idx[i + 1], idx[i + 2], idx[0]])
+            .collect(),
+        _ => Vec::new(),
+    }
+}
