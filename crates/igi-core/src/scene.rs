@@ -40,7 +40,7 @@ impl Camera {
     }
 
     /// The primary ray direction through the centre of pixel (x, y) of a width x height
-    /// image, y = 0 the top row: the CPU twin of frame.wgsl's `camera_ray_dir` (frame 0 of
+    /// image, y = 0 the top row: the CPU twin of direct.wgsl's `camera_ray_dir` (frame 0 of
     /// an accumulation, which looks through pixel centres).
     pub fn pixel_dir(&self, width: u32, height: u32, x: u32, y: u32) -> Vec3 {
         let (forward, right, up) = self.basis();
@@ -119,7 +119,7 @@ fn pow2(j: i32) -> f32 {
 /// `e` times the power of two that brings its largest component into [0.5, 1) (zero stays
 /// zero). Only exponents change, so the products of two scaled edges round exactly as the
 /// unscaled ones do, without their overflow (edges past ~1e19) or underflow. Twin of
-/// frame.wgsl's `scale_pow2`; the factor is applied in two halves so that each stays a
+/// surface.wgsl's `scale_pow2`; the factor is applied in two halves so that each stays a
 /// normal f32.
 pub fn scale_pow2(e: Vec3A) -> Vec3A {
     let m = e.abs().max_element();

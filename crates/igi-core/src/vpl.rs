@@ -31,12 +31,12 @@ pub struct SurfaceHit {
     pub mirror: Vec3,
 }
 
-/// Shading data at a closest hit (twin of `surface_at` in frame.wgsl).
+/// Shading data at a closest hit (twin of `surface_at` in surface.wgsl).
 pub fn surface_at(scene: &Scene, bvh: &Bvh, dir: Vec3, slot: u32, u: f32, v: f32) -> SurfaceHit {
     let tri = &scene.triangles[bvh.tri_order[slot as usize] as usize];
     let w = 1.0 - u - v;
     let position = w * tri.v[0] + u * tri.v[1] + v * tri.v[2];
-    // Twin of frame.wgsl's geometric_normal (the loaders keep only triangles that have one).
+    // Twin of surface.wgsl's geometric_normal (the loaders keep only triangles that have one).
     let mut ng = crate::scene::geometric_normal(&tri.v).unwrap_or(Vec3::Z);
     if ng.dot(dir) > 0.0 {
         ng = -ng;

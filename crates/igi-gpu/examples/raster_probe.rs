@@ -59,7 +59,7 @@ fn run() -> Result<(), String> {
     }
     let device = &ctx.device;
 
-    // The camera of igi's primary rays (frame.wgsl camera_ray_dir, pixel centres).
+    // The camera of igi's primary rays (direct.wgsl camera_ray_dir, pixel centres).
     let cam = scene.camera;
     let aspect = width as f32 / height as f32;
     let (lo, hi) = scene.bounds();

@@ -15,8 +15,8 @@ pub mod profiler;
 pub mod raybench;
 pub mod scene_buffers;
 pub mod shader;
+pub mod shaders;
 pub mod switches;
-pub mod twins;
 
 pub use context::{AdapterChoice, GpuContext, GpuError};
 pub use frame::{FrameOutput, Passes, Renderer};

@@ -44,7 +44,7 @@ fn point_light_over_diffuse_plane() {
     let mut worst = 0.0f32;
     for y in 0..settings.height {
         for x in 0..settings.width {
-            // The camera of frame.wgsl, on the CPU.
+            // The camera of direct.wgsl, on the CPU.
             let d = camera.pixel_dir(settings.width, settings.height, x, y);
             let t = -camera.eye.y / d.y;
             assert!(t > 0.0, "every pixel sees the plane");

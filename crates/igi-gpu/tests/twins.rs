@@ -14,10 +14,10 @@ use igi_core::settings::{
     Accelerations, FilterMode, GeometryBound, InterleavePattern, OutputBuffer, RenderSettings,
 };
 use igi_gpu::layout::FrameParams;
-use igi_gpu::twins::compose::Compose;
-use igi_gpu::twins::filter::Filter;
-use igi_gpu::twins::gather::Gather;
-use igi_gpu::twins::Rgba;
+use igi_gpu::passes::compose::cpu::Compose;
+use igi_gpu::passes::filter::cpu::Filter;
+use igi_gpu::passes::indirect::cpu::Gather;
+use igi_gpu::shaders::gbuffer::Rgba;
 use igi_gpu::{GpuContext, Renderer};
 
 /// The sizes every twin is tried at: one that the 8 x 8 workgroups and the 2 x 2 and
@@ -281,7 +281,7 @@ fn filter_setups() -> Vec<Accelerations> {
 }
 
 /// The discontinuity buffer and the fused filter (filter.wgsl), and the discontinuity
-/// buffer over the mirror record, against `twins::filter`.
+/// buffer over the mirror record, against `passes::filter::cpu`.
 ///
 /// Bounds, every pixel: the discontinuity buffer within 1e-6 relative. It adds the same
 /// samples in the same order and divides once: additions are correctly rounded on both
@@ -443,7 +443,7 @@ const OUTPUTS: [OutputBuffer; 6] = [
 ];
 
 /// compose.wgsl's `main` (E at full resolution: canonical frames, interleaving alone,
-/// the fused filter) against `twins::compose`, for every output buffer, and one
+/// the fused filter) against `passes::compose::cpu`, for every output buffer, and one
 /// accumulated frame (accumulate_index 1, over the GPU's colour of frame 0).
 ///
 /// Bound: 1e-6 relative, every pixel. Compose is a few products and sums per pixel
@@ -503,7 +503,7 @@ fn compose_twin_matches_the_gpu() {
 }
 
 /// Joint bilateral upsampling (upsample.wgsl, as compose's `main_upsampled` runs it)
-/// against `twins::upsample`: downsampling by 2 and 4, with and without interleaving
+/// against `shaders::upsample`: downsampling by 2 and 4, with and without interleaving
 /// (the discontinuity buffer before it), depth in the range weight on and off, normal
 /// powers 1 and 4. The irradiance output shows the upsampled E itself; the final one
 /// composes it.
@@ -555,7 +555,7 @@ fn upsample_twin_matches_the_gpu() {
     }
 }
 
-/// The indirect gather (gather.wgsl in indirect.wgsl) against `twins::gather`, at the
+/// The indirect gather (gather.wgsl in indirect.wgsl) against `passes::indirect::cpu`, at the
 /// pixels of the indirect term and, in scenes with mirrors, at the mirrored hits (the
 /// mirror indirect stage, over the pixels the direct pass listed): canonical,
 /// downsampled by 2 and 4, interleaved 3 x 3 regular and irregular and 2 x 4, both

@@ -2,6 +2,8 @@
 //! with E at full resolution or upsampled on the way (joint bilateral upsampling, paper
 //! section 4.2), averaged over accumulated frames. See `compose.wgsl`.
 
+pub mod cpu;
+
 use super::bindings::{bind, compute_layout};
 use super::{image_groups, pipeline, Step};
 use crate::frame::recorder::FramePass;

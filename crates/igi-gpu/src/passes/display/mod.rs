@@ -1,6 +1,6 @@
 //! The viewer's display (after the paper's frame, section 4): the composed linear image
 //! onto a window's surface, and optionally the frame's VPLs drawn as dots. A render pass,
-//! not a compute stage: `igi render` never runs it. See `shaders/display.wgsl`.
+//! not a compute stage: `igi render` never runs it. See `display.wgsl`.
 
 use super::bindings::{bind, layout_of, Bindings};
 use crate::layout::DisplayParams;

@@ -3,6 +3,8 @@
 //! work). Joint bilateral upsampling on its own is done by the compose pass as it writes
 //! each pixel. See `filter.wgsl`.
 
+pub mod cpu;
+
 use super::bindings::{bind, compute_layout};
 use super::{image_groups, pipeline, Step};
 use crate::frame::recorder::FramePass;

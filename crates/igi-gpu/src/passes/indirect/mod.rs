@@ -5,6 +5,8 @@
 //! the paper gathers every VPL there and leaves that cost as future work).
 //! See `indirect.wgsl`.
 
+pub mod cpu;
+
 use super::bindings::{bind, compute_layout};
 use super::{GatherPipelines, LanePipelines, Step};
 use crate::frame::recorder::FramePass;

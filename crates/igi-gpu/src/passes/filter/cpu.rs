@@ -1,13 +1,13 @@
-//! CPU twin of `shaders/filter.wgsl`: the discontinuity buffer at the indirect term's
+//! CPU twin of `filter.wgsl`: the discontinuity buffer at the indirect term's
 //! resolution (paper section 4.3) and the fused filter that also upsamples (the paper's
 //! future work). Function by function as the WGSL, with its names; the WGSL's bindings
 //! are the fields of [`Filter`], and each entry point becomes a function of one
 //! invocation plus one that runs it over the whole grid, as the dispatch does. The fused
-//! filter gathers through [`super::upsample`], as filter.wgsl through upsample.wgsl.
+//! filter gathers through [`crate::shaders::upsample`], as filter.wgsl through upsample.wgsl.
 
-use super::upsample::{gathered_value, new_gathered, xyz, Upsampler};
-use super::{representative_pixel, Rgba};
 use crate::layout::FrameParams;
+use crate::shaders::gbuffer::{representative_pixel, Rgba};
+use crate::shaders::upsample::{gathered_value, new_gathered, xyz, Upsampler};
 use glam::Vec3;
 
 /// filter.wgsl's bindings: the frame's parameters (the main ones, or the mirror pass's

@@ -1,11 +1,11 @@
 //! CPU twin of `shaders/upsample.wgsl`: joint bilateral upsampling of the downsampled
 //! indirect term (paper section 4.2), and the gatherer it shares with the fused filter
-//! (`filter.wgsl`, [`super::filter`]). Function by function as the WGSL, with its names;
+//! (`filter.wgsl`, [`crate::passes::filter::cpu`]). Function by function as the WGSL, with its names;
 //! the WGSL's globals (`params`, `gbuf_normal` and the includer's `low_irradiance`) are
 //! the fields of [`Upsampler`].
 
-use super::{representative_pixel, Rgba};
 use crate::layout::FrameParams;
+use crate::shaders::gbuffer::{representative_pixel, Rgba};
 use glam::Vec3;
 
 /// What upsample.wgsl reads: the frame's parameters, the G-buffer's shading normals (w:

@@ -1,7 +1,7 @@
-//! CPU twin of `shaders/gather.wgsl` as `shaders/indirect.wgsl` runs it: E at the
+//! CPU twin of `shaders/gather.wgsl` as `indirect.wgsl` runs it: E at the
 //! representative pixel of each pixel of the indirect term, from the VPLs of its
 //! interleaving subset (paper sections 4 and 4.3), E(x) = n m sum_k Phi_k (rho_k / pi)
-//! V(x, y_k) G(x, y_k) with the bounded G of frame.wgsl. Function by function as the
+//! V(x, y_k) G(x, y_k) with the bounded G of geometry_term.wgsl. Function by function as the
 //! WGSL, with its names; its bindings are the fields of [`Gather`], and its dispatches
 //! over the ranges of the VPL list and its lanes are the arguments of [`Gather::image`],
 //! so that the twin adds what the GPU adds in the order the GPU adds it.
@@ -11,14 +11,14 @@
 //! (boxes for triangles) has no CPU walk, so this twin gathers with perfect visibility
 //! only.
 
-use super::upsample::xyz;
-use super::{representative_pixel, Rgba};
 use crate::layout::{FrameParams, Vpl};
+use crate::shaders::gbuffer::{representative_pixel, Rgba};
+use crate::shaders::upsample::xyz;
 use glam::Vec3;
 use igi_core::bvh::{offset_ray_origin, Bvh};
 use igi_core::sampling::hash_u32;
 
-/// PI of frame.wgsl (3.14159265358979 there, the same f32).
+/// PI of constants.wgsl (3.14159265358979 there, the same f32).
 pub const PI: f32 = std::f32::consts::PI;
 
 /// indirect.wgsl's bindings (and the BVH of its scene bind group): the VPL list (its
@@ -157,7 +157,7 @@ impl Gather<'_> {
         e
     }
 
-    /// `bounded_inverse_square` of frame.wgsl: the paper's smoothstep(0.8 m, 1.2 m, d) /
+    /// `bounded_inverse_square` of geometry_term.wgsl: the paper's smoothstep(0.8 m, 1.2 m, d) /
     /// d^2, or the classic clamp 1 / max(d^2, m^2).
     pub fn bounded_inverse_square(&self, dist2: f32) -> f32 {
         let m = self.params.min_dist;

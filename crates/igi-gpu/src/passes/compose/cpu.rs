@@ -1,16 +1,16 @@
-//! CPU twin of `shaders/compose.wgsl`: the final image L = direct_specular +
+//! CPU twin of `compose.wgsl`: the final image L = direct_specular +
 //! (rho_d / pi) E, the mirrored hits' indirect light, the inspection buffers
 //! (`params.output`) and the running mean of accumulation. Function by function as the
 //! WGSL, with its names; its bindings are the fields of [`Compose`]. Entry point `main`
 //! reads E at full resolution, `main_upsampled` upsamples it through
-//! [`super::upsample`], as compose.wgsl through upsample.wgsl.
+//! [`crate::shaders::upsample`], as compose.wgsl through upsample.wgsl.
 
-use super::upsample::{xyz, Upsampler};
-use super::Rgba;
 use crate::layout::FrameParams;
+use crate::shaders::gbuffer::Rgba;
+use crate::shaders::upsample::{xyz, Upsampler};
 use glam::Vec3;
 
-/// PI of frame.wgsl (3.14159265358979 there, the same f32).
+/// PI of constants.wgsl (3.14159265358979 there, the same f32).
 pub const PI: f32 = std::f32::consts::PI;
 
 /// compose.wgsl's bindings but the colour buffer, which the entry points take as
