@@ -161,6 +161,29 @@ impl Accelerations {
     pub fn filtered(&self) -> bool {
         self.downsample > 1 || self.interleave != (1, 1)
     }
+
+    /// Every parameter within what the passes can honour: downsampling 1 to
+    /// [`MAX_DOWNSAMPLE`], interleaving within [`check_interleave`], the upsampler's sigma
+    /// and the depth threshold positive, the normal power not negative and the normal
+    /// threshold a cosine. An idle modifier is not refused here (see
+    /// [`RenderSettings::validate`]).
+    pub fn validate(&self) -> Result<(), SettingsError> {
+        if self.downsample == 0 || self.downsample > MAX_DOWNSAMPLE {
+            return Err(SettingsError::Downsample(self.downsample));
+        }
+        let (n, m) = self.interleave;
+        check_interleave(n, m).map_err(|_| SettingsError::Interleave { n, m })?;
+        positive(self.upsample_sigma, SettingsError::UpsampleSigma)?;
+        let k = self.upsample_normal_power;
+        if !(k.is_finite() && k >= 0.0) {
+            return Err(SettingsError::NormalPower(k));
+        }
+        positive(self.depth_threshold, SettingsError::DepthThreshold)?;
+        if !(-1.0..=1.0).contains(&self.normal_threshold) {
+            return Err(SettingsError::NormalThreshold(self.normal_threshold));
+        }
+        Ok(())
+    }
 }
 
 /// Everything that decides what a frame computes (not where it goes).
@@ -196,6 +219,104 @@ pub struct RenderSettings {
 /// pass to 7 segments. It also bounds the work of a pixel that sees a hall of mirrors
 /// (one closest-hit ray per reflection); the viewer's slider stops at 16.
 pub const MAX_MIRROR_DEPTH: u32 = 1024;
+
+/// Most VPL subsets of interleaved sampling, n x m of [`Accelerations::interleave`]: the
+/// passes keep one permutation entry and one mirror-list counter per subset in arrays of
+/// this size (`MAX_SUBSETS` of the WGSL).
+pub const MAX_SUBSETS: u32 = 64;
+
+/// Largest downsampling factor of [`Accelerations::downsample`]: a bound that refuses a
+/// mistyped factor (thousands) rather than computing the indirect light of a frame on a
+/// handful of pixels; at 64 a 1920 x 1080 frame still has 30 x 17 of them.
+pub const MAX_DOWNSAMPLE: u32 = 64;
+
+/// Why settings were refused ([`RenderSettings::validate`]). The messages name the
+/// command's options, which map one to one onto the fields, so that `igi render`, `igi
+/// view`, `igi bench` and the renderer say the same thing of the same value.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum SettingsError {
+    #[error("--exposure must be a positive number, got {0}")]
+    Exposure(f32),
+    #[error("--vpls must be at least 1")]
+    NoVpls,
+    #[error("--bounces must be at least 1")]
+    NoBounces,
+    #[error("--accumulate must be at least 1")]
+    NoAccumulatedFrames,
+    #[error("--mirror-depth must be at most {MAX_MIRROR_DEPTH}, got {0}")]
+    MirrorDepth(u32),
+    #[error("--min-dist must be a positive number, got {0}")]
+    MinDist(f32),
+    #[error("--downsample must be between 1 and {MAX_DOWNSAMPLE}, got {0}")]
+    Downsample(u32),
+    /// An interleave side of 0 ([`check_interleave`]: the option's own parser says it).
+    #[error("{n}x{m}: each side must be at least 1")]
+    InterleaveSide { n: u32, m: u32 },
+    /// More than [`MAX_SUBSETS`] subsets ([`check_interleave`]).
+    #[error("{n}x{m} is {subsets} subsets: N x M must be at most {MAX_SUBSETS}")]
+    InterleaveSubsets { n: u32, m: u32, subsets: u64 },
+    /// Either interleave refusal, of settings made elsewhere than by the option's parser.
+    #[error("--interleave {n}x{m}: each side must be at least 1 and N x M at most {MAX_SUBSETS}")]
+    Interleave { n: u32, m: u32 },
+    #[error("--upsample-sigma must be a positive number, got {0}")]
+    UpsampleSigma(f32),
+    #[error("--normal-power must be a number >= 0, got {0}")]
+    NormalPower(f32),
+    #[error("--depth-threshold must be a positive number, got {0}")]
+    DepthThreshold(f32),
+    #[error("--normal-threshold must be between -1 and 1, got {0}")]
+    NormalThreshold(f32),
+    /// The irregular pattern without interleaving; `from_setup` names the set-up it came
+    /// from, where it came from one.
+    #[error(
+        "{} lays out interleaved VPL subsets: it needs --interleave NxM (or il in --setup)",
+        from_setup_named("--pattern irregular", from_setup)
+    )]
+    IrregularWithoutInterleave { from_setup: Option<String> },
+    /// The fused filter with neither downsampling nor interleaving, which run no filter.
+    #[error(
+        "{} runs the filters of downsampling and interleaving in one pass: it needs --downsample S or --interleave NxM (or ds or il in --setup)",
+        from_setup_named("--filter fused", from_setup)
+    )]
+    FusedWithoutFilter { from_setup: Option<String> },
+    #[error("image size {width}x{height}: both must be at least 1")]
+    ImageSize { width: u32, height: u32 },
+}
+
+fn from_setup_named(option: &str, setup: &Option<String>) -> String {
+    match setup {
+        Some(setup) => format!("{option} (from --setup {setup})"),
+        None => option.to_string(),
+    }
+}
+
+/// An exposure is a positive multiplier.
+pub fn check_exposure(exposure: f32) -> Result<(), SettingsError> {
+    positive(exposure, SettingsError::Exposure)
+}
+
+/// Interleaving over n x m subsets: each side at least 1, and at most [`MAX_SUBSETS`]
+/// subsets, the product taken in 64 bits (two u32 sides can wrap around to a small
+/// number in 32).
+pub fn check_interleave(n: u32, m: u32) -> Result<(), SettingsError> {
+    if n == 0 || m == 0 {
+        return Err(SettingsError::InterleaveSide { n, m });
+    }
+    let subsets = u64::from(n) * u64::from(m);
+    if subsets > u64::from(MAX_SUBSETS) {
+        return Err(SettingsError::InterleaveSubsets { n, m, subsets });
+    }
+    Ok(())
+}
+
+/// `Ok` for a finite number above 0, else the error `refused` makes of it.
+fn positive(v: f32, refused: fn(f32) -> SettingsError) -> Result<(), SettingsError> {
+    if v.is_finite() && v > 0.0 {
+        Ok(())
+    } else {
+        Err(refused(v))
+    }
+}
 
 impl Default for RenderSettings {
     fn default() -> Self {
@@ -239,6 +360,68 @@ impl RenderSettings {
     pub fn min_dist_for(&self, scene: &Scene) -> f32 {
         self.min_dist.unwrap_or_else(|| default_min_dist(scene))
     }
+
+    /// The one check of settings, made by every command before it renders: the
+    /// [`limits`](Self::validate_limits) but the image size, then no idle modifier (a
+    /// pattern or filter mode that would label a frame with what it did not compute), then
+    /// the image size. The first refusal is returned, in that order, which is the order of
+    /// the command's options.
+    pub fn validate(&self) -> Result<(), SettingsError> {
+        self.validate_parameters()?;
+        self.validate_size()
+    }
+
+    /// [`validate`](Self::validate) but for the image size: what a command can check
+    /// before the scene, whose film gives the default size, is loaded.
+    pub fn validate_parameters(&self) -> Result<(), SettingsError> {
+        self.validate_frame_limits()?;
+        match self.accelerations.idle_modifier() {
+            Some("irregular") => {
+                Err(SettingsError::IrregularWithoutInterleave { from_setup: None })
+            }
+            Some(_) => Err(SettingsError::FusedWithoutFilter { from_setup: None }),
+            None => Ok(()),
+        }
+    }
+
+    /// What any frame needs, idle modifiers allowed (the renderer ignores them, and the
+    /// viewer's panel can leave one): the exposure positive; at least one VPL, bounce and
+    /// accumulated frame; the mirror depth at most [`MAX_MIRROR_DEPTH`]; a given bounding
+    /// distance positive; [`Accelerations::validate`]; and an image of at least 1 x 1.
+    pub fn validate_limits(&self) -> Result<(), SettingsError> {
+        self.validate_frame_limits()?;
+        self.validate_size()
+    }
+
+    fn validate_frame_limits(&self) -> Result<(), SettingsError> {
+        check_exposure(self.exposure)?;
+        if self.vpls == 0 {
+            return Err(SettingsError::NoVpls);
+        }
+        if self.bounces == 0 {
+            return Err(SettingsError::NoBounces);
+        }
+        if self.accumulate == 0 {
+            return Err(SettingsError::NoAccumulatedFrames);
+        }
+        if self.mirror_depth > MAX_MIRROR_DEPTH {
+            return Err(SettingsError::MirrorDepth(self.mirror_depth));
+        }
+        if let Some(m) = self.min_dist {
+            positive(m, SettingsError::MinDist)?;
+        }
+        self.accelerations.validate()
+    }
+
+    fn validate_size(&self) -> Result<(), SettingsError> {
+        if self.width == 0 || self.height == 0 {
+            return Err(SettingsError::ImageSize {
+                width: self.width,
+                height: self.height,
+            });
+        }
+        Ok(())
+    }
 }
 
 #[cfg(test)]
@@ -279,5 +462,179 @@ mod tests {
         assert!(e.contains("fused modifies ds or il"), "{e}");
         assert!(Accelerations::from_setup("ds+fused").is_ok());
         assert!(Accelerations::from_setup("il+irregular").is_ok());
+    }
+
+    /// The message of `settings` changed by `change`, which must be refused.
+    fn refusal(change: impl FnOnce(&mut RenderSettings)) -> String {
+        let mut settings = RenderSettings::default();
+        change(&mut settings);
+        settings.validate().expect_err("refused").to_string()
+    }
+
+    #[test]
+    fn defaults_and_the_papers_set_ups_are_valid() {
+        assert_eq!(RenderSettings::default().validate(), Ok(()));
+        for setup in [
+            "canonical",
+            "iv",
+            "iv+ds",
+            "iv+ds+il",
+            "iv+ds+il+irregular+fused",
+        ] {
+            let settings = RenderSettings {
+                accelerations: Accelerations::from_setup(setup).unwrap(),
+                ..RenderSettings::default()
+            };
+            assert_eq!(settings.validate(), Ok(()), "{setup}");
+        }
+        // The largest of each.
+        let mut settings = RenderSettings {
+            mirror_depth: MAX_MIRROR_DEPTH,
+            ..RenderSettings::default()
+        };
+        settings.accelerations.downsample = MAX_DOWNSAMPLE;
+        settings.accelerations.interleave = (8, 8);
+        settings.accelerations.normal_threshold = -1.0;
+        settings.accelerations.upsample_normal_power = 0.0;
+        assert_eq!(settings.validate(), Ok(()));
+    }
+
+    #[test]
+    fn frame_parameters_out_of_range_are_refused() {
+        for exposure in [0.0, -1.0, f32::NAN, f32::INFINITY] {
+            let e = refusal(|s| s.exposure = exposure);
+            assert_eq!(
+                e,
+                format!("--exposure must be a positive number, got {exposure}")
+            );
+        }
+        assert_eq!(refusal(|s| s.vpls = 0), "--vpls must be at least 1");
+        assert_eq!(refusal(|s| s.bounces = 0), "--bounces must be at least 1");
+        assert_eq!(
+            refusal(|s| s.accumulate = 0),
+            "--accumulate must be at least 1"
+        );
+        // u32::MAX wrapped the VPL pass's path length (bounces + mirror depth) to 7.
+        for depth in [MAX_MIRROR_DEPTH + 1, u32::MAX] {
+            let e = refusal(|s| s.mirror_depth = depth);
+            assert_eq!(
+                e,
+                format!("--mirror-depth must be at most 1024, got {depth}")
+            );
+        }
+        for m in [0.0, -0.5, f32::NAN] {
+            let e = refusal(|s| s.min_dist = Some(m));
+            assert_eq!(e, format!("--min-dist must be a positive number, got {m}"));
+        }
+        let e = refusal(|s| s.width = 0);
+        assert_eq!(e, "image size 0x600: both must be at least 1");
+        let e = refusal(|s| s.height = 0);
+        assert_eq!(e, "image size 800x0: both must be at least 1");
+    }
+
+    #[test]
+    fn acceleration_parameters_out_of_range_are_refused() {
+        for ds in [0, MAX_DOWNSAMPLE + 1] {
+            let e = refusal(|s| s.accelerations.downsample = ds);
+            assert_eq!(
+                e,
+                format!("--downsample must be between 1 and 64, got {ds}")
+            );
+        }
+        // 65536 x 65536 is 0 in u32.
+        for (n, m) in [(65_536, 65_536), (8, 9), (0, 4), (3, 0), (u32::MAX, 2)] {
+            let e = refusal(|s| s.accelerations.interleave = (n, m));
+            assert_eq!(
+                e,
+                format!("--interleave {n}x{m}: each side must be at least 1 and N x M at most 64")
+            );
+        }
+        for sigma in [0.0, -1.0, f32::NAN, f32::INFINITY] {
+            let e = refusal(|s| s.accelerations.upsample_sigma = sigma);
+            assert_eq!(
+                e,
+                format!("--upsample-sigma must be a positive number, got {sigma}")
+            );
+        }
+        for k in [-1.0, f32::NAN, f32::INFINITY] {
+            let e = refusal(|s| s.accelerations.upsample_normal_power = k);
+            assert_eq!(e, format!("--normal-power must be a number >= 0, got {k}"));
+        }
+        for t in [0.0, -0.1, f32::NAN] {
+            let e = refusal(|s| s.accelerations.depth_threshold = t);
+            assert_eq!(
+                e,
+                format!("--depth-threshold must be a positive number, got {t}")
+            );
+        }
+        for c in [-1.5, 1.01, f32::NAN] {
+            let e = refusal(|s| s.accelerations.normal_threshold = c);
+            assert_eq!(
+                e,
+                format!("--normal-threshold must be between -1 and 1, got {c}")
+            );
+        }
+    }
+
+    #[test]
+    fn interleave_sides_are_checked_in_64_bits() {
+        assert_eq!(check_interleave(8, 8), Ok(()));
+        assert_eq!(check_interleave(1, 64), Ok(()));
+        let e = check_interleave(0, 3).unwrap_err().to_string();
+        assert_eq!(e, "0x3: each side must be at least 1");
+        let e = check_interleave(65_536, 65_536).unwrap_err().to_string();
+        assert_eq!(
+            e,
+            "65536x65536 is 4294967296 subsets: N x M must be at most 64"
+        );
+        let e = check_interleave(8, 9).unwrap_err().to_string();
+        assert_eq!(e, "8x9 is 72 subsets: N x M must be at most 64");
+    }
+
+    #[test]
+    fn idle_modifiers_are_refused_but_within_the_limits() {
+        let irregular: fn(&mut RenderSettings) =
+            |s| s.accelerations.pattern = InterleavePattern::Irregular;
+        let fused: fn(&mut RenderSettings) = |s| s.accelerations.filter = FilterMode::Fused;
+        assert_eq!(
+            refusal(irregular),
+            "--pattern irregular lays out interleaved VPL subsets: it needs --interleave NxM (or il in --setup)"
+        );
+        assert_eq!(
+            refusal(fused),
+            "--filter fused runs the filters of downsampling and interleaving in one pass: it needs --downsample S or --interleave NxM (or ds or il in --setup)"
+        );
+        let e = SettingsError::IrregularWithoutInterleave {
+            from_setup: Some("il+irregular".into()),
+        };
+        assert!(
+            e.to_string()
+                .starts_with("--pattern irregular (from --setup il+irregular) lays out"),
+            "{e}"
+        );
+        // The viewer's panel can leave a modifier idle, and the renderer ignores it.
+        for change in [irregular, fused] {
+            let mut settings = RenderSettings::default();
+            change(&mut settings);
+            assert_eq!(settings.validate_limits(), Ok(()));
+        }
+    }
+
+    #[test]
+    fn the_image_size_is_checked_last_and_apart() {
+        let settings = RenderSettings {
+            width: 0,
+            vpls: 0,
+            ..RenderSettings::default()
+        };
+        // The options' order: the VPL count before the image size.
+        assert_eq!(settings.validate(), Err(SettingsError::NoVpls));
+        let settings = RenderSettings {
+            width: 0,
+            ..RenderSettings::default()
+        };
+        // Before the scene is loaded the size is not known yet.
+        assert_eq!(settings.validate_parameters(), Ok(()));
+        assert!(settings.validate_limits().is_err());
     }
 }

@@ -1,7 +1,7 @@
 //! `igi bench build`: the BVH build timed on the user's own scenes (the acceleration
 //! structure that OptiX built for Marques and Santos; igi builds its own on the CPU). The
 //! figures and their lines are those of the `bvh_build` example, whose rounds
-//! `scripts/build-bench.sh` pairs for the build target of docs/PERFORMANCE.md.
+//! `scripts/build-bench.sh` pairs to compare two builds of igi.
 
 use anyhow::{bail, Result};
 use igi_core::bvh::timing::time_builds;

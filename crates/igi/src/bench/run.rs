@@ -319,6 +319,7 @@ pub fn run(opts: &BenchOptions) -> Result<BenchResults> {
                     accelerations: accelerations.clone(),
                     ..RenderSettings::for_scene(&scene)
                 };
+                settings.validate()?;
                 // Warm-up (`WarmUp`): the frames asked for, and at least 0.5 s of frames, so
                 // that the GPU's clocks are up again after the CPU work between
                 // combinations (writing images, FLIP).

@@ -452,6 +452,9 @@ impl Viewer {
                 frame: settings.frame + self.accumulated,
                 ..settings.clone()
             };
+            // The panel keeps every value within these limits; a modifier it leaves idle
+            // (a pattern without interleaving) is no error here, as the renderer ignores it.
+            frame.validate_limits()?;
             let (names, _) = self
                 .renderer
                 .submit_frame(&self.ctx, &frame, self.accumulated)?;
