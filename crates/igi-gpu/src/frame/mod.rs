@@ -31,7 +31,7 @@ use igi_core::bvh::Bvh;
 use igi_core::image::Image;
 use igi_core::sampling::{halton_base, pilot_base, DigitPermutations};
 use igi_core::scene::{Camera, PointLight, Scene};
-use igi_core::settings::{RenderSettings, MAX_MIRROR_DEPTH};
+use igi_core::settings::{RenderSettings, SettingsError, MAX_MIRROR_DEPTH};
 use resources::{Buf, FrameBuffers};
 
 /// Most stages a frame can have: every pass in a stage of its own (`IGI_SIDE_BY_SIDE=0`)
@@ -749,39 +749,21 @@ fn light_powers(lights: &[PointLight]) -> (f32, [f32; 3]) {
     (sum, total.to_array())
 }
 
-/// Reject settings the passes cannot honour: acceleration parameters, and a mirror depth
-/// past [`MAX_MIRROR_DEPTH`].
+/// Reject settings the passes cannot honour, by igi-core's validation (the one the
+/// command, the bench and the viewer run): the accelerations' parameters, and a mirror
+/// depth past [`MAX_MIRROR_DEPTH`]. Counts of zero (VPLs, bounces, frames) are taken as
+/// one here, as the frame always has.
 fn check_settings(settings: &RenderSettings) -> Result<(), GpuError> {
+    let refuse = |e: SettingsError| GpuError::Limit(e.to_string());
     if settings.mirror_depth > MAX_MIRROR_DEPTH {
-        return Err(GpuError::Limit(format!(
-            "mirror depth {}: at most {MAX_MIRROR_DEPTH} reflections",
-            settings.mirror_depth
-        )));
+        return Err(refuse(SettingsError::MirrorDepth(settings.mirror_depth)));
     }
-    let a = &settings.accelerations;
-    let (n, m) = a.interleave;
-    // In 64 bits: n x m of two large u32 sides wraps around in 32.
-    if n == 0 || m == 0 || u64::from(n) * u64::from(m) > u64::from(MAX_SUBSETS) {
-        return Err(GpuError::Limit(format!(
-            "interleave {n}x{m}: each side must be at least 1 and n x m at most {MAX_SUBSETS}"
-        )));
-    }
-    if a.downsample == 0 || a.downsample > 64 {
-        return Err(GpuError::Limit(format!(
-            "downsample {}: must be between 1 and 64",
-            a.downsample
-        )));
-    }
-    if !(a.upsample_sigma > 0.0 && a.depth_threshold > 0.0 && a.upsample_normal_power >= 0.0) {
-        return Err(GpuError::Limit(
-            "filter parameters: sigma and depth threshold must be positive, the normal power not negative".into(),
-        ));
-    }
-    Ok(())
+    settings.accelerations.validate().map_err(refuse)
 }
 
-/// Most VPL subsets of interleaved sampling (the irregular pattern's permutation array).
-pub const MAX_SUBSETS: u32 = 64;
+/// Most VPL subsets of interleaved sampling (igi-core's limit, which the WGSL's mirror
+/// list and irregular pattern are sized for).
+pub const MAX_SUBSETS: u32 = igi_core::settings::MAX_SUBSETS;
 
 #[cfg(test)]
 mod tests {
