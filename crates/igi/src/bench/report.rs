@@ -165,7 +165,6 @@ pub fn file_stem(scene: &str) -> String {
     }
 }
 
-
 #[cfg(test)]
 mod tests {
     use super::super::model::*;
@@ -519,4 +518,3 @@ mod tests {
         );
     }
 }
-

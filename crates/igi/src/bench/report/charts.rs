@@ -516,4 +516,3 @@ fn draw_errors<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, sc: &SceneRuns
         .collect();
     draw_legend(&legend, "Set-ups (points: VPLs)", &entries)
 }
-

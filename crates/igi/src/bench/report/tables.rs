@@ -281,4 +281,3 @@ pub fn to_markdown(results: &BenchResults) -> String {
     }
     s
 }
-
