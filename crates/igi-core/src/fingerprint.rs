@@ -1,7 +1,7 @@
 //! FNV-1a fingerprints that tell two outputs apart without storing them: the BVH's tree
 //! hash (`bvh::timing::tree_hash`: the same tree after a change to the builder) and the
 //! ray bench's answers hash (`igi bench rays`: two traversals answered alike). Not part
-//! of the paper; the checks behind docs/PERFORMANCE.md's "the same tree" and "the same
+//! of the paper; the checks behind the lab log's "the same tree" and "the same
 //! answers".
 
 /// 64-bit FNV-1a over `items`, each folded in as one value (bytes or 32-bit words: the
