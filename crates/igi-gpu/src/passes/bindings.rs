@@ -1,5 +1,5 @@
 //! Typed bindings. Each bind group of a pass is a struct of named buffer fields, declared
-//! with [`bindings!`] in the order of its WGSL `@binding` numbers, each field with its
+//! with [`bindings!`](crate::bindings!) in the order of its WGSL `@binding` numbers, each field with its
 //! access (a parameter block, read-only or read-write storage). The struct makes the bind
 //! group layout and the bind group, so the two cannot disagree, and a caller names every
 //! buffer it binds: two read-only buffers swapped no longer validate by position alone.
@@ -56,7 +56,7 @@ pub struct GroupDecl {
     pub bindings: &'static [Binding],
 }
 
-/// A bind group's buffers by name, as a struct made by [`bindings!`].
+/// A bind group's buffers by name, as a struct made by [`bindings!`](crate::bindings!).
 pub trait Bindings<'a> {
     /// The bindings in `@binding` order.
     const BINDINGS: &'static [Binding];
