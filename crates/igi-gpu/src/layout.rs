@@ -154,6 +154,19 @@ pub struct FrameParams {
     pub _pad: [u32; 2],
 }
 
+impl FrameParams {
+    /// The same frame for the passes over the mirrored hits, whose record is at full
+    /// resolution: the indirect term's resolution is the image's, with no downsampling.
+    pub fn at_full_resolution(&self) -> FrameParams {
+        FrameParams {
+            low_width: self.width,
+            low_height: self.height,
+            downsample: 1,
+            ..*self
+        }
+    }
+}
+
 /// Parameters of the viewer's display pass (uniform buffer, 48 bytes, storage on software
 /// adapters as [`FrameParams`]; `passes/display/display.wgsl`).
 /// | offset | field | |

@@ -48,65 +48,6 @@ fn scenes() -> Vec<(&'static str, Scene)> {
     scenes
 }
 
-/// The frame's parameters as `Renderer` writes them (frame.rs `frame_params`), for the
-/// fields the twins read: the image and its indirect term's resolution, the
-/// accelerations, the output choice and accumulation, the camera's eye and the scene's
-/// scale. A field set wrongly here makes a twin disagree with the GPU, so the tests
-/// check this too.
-fn frame_params(scene: &Scene, s: &RenderSettings, accumulate_index: u32) -> FrameParams {
-    let a = &s.accelerations;
-    let low = igi_gpu::frame::low_resolution(s);
-    let diagonal = scene.diagonal();
-    FrameParams {
-        cam_eye: scene.camera.eye.to_array(),
-        width: s.width,
-        height: s.height,
-        min_dist: s.min_dist_for(scene),
-        geometry_bound: match s.geometry_bound {
-            GeometryBound::Smoothstep => 0,
-            GeometryBound::Clamp => 1,
-        },
-        output: match s.output {
-            OutputBuffer::Final => 0,
-            OutputBuffer::Direct => 1,
-            OutputBuffer::Indirect => 2,
-            OutputBuffer::Irradiance => 3,
-            OutputBuffer::Normals => 4,
-            OutputBuffer::Depth => 5,
-        },
-        low_width: low.0,
-        low_height: low.1,
-        downsample: a.downsample.max(1),
-        interleave_n: a.interleave.0.max(1),
-        interleave_m: a.interleave.1.max(1),
-        pattern: match a.pattern {
-            InterleavePattern::Regular => 0,
-            InterleavePattern::Irregular => 1,
-        },
-        seed: s.seed,
-        accumulate_index,
-        upsample_sigma: a.upsample_sigma,
-        normal_power: a.upsample_normal_power,
-        upsample_depth: a.upsample_depth as u32,
-        depth_threshold: a.depth_threshold,
-        normal_threshold: a.normal_threshold,
-        depth_scale: 1.0 / diagonal.max(f32::MIN_POSITIVE),
-        ray_offset_floor: scene.ray_offset_floor(),
-        ..FrameParams::default()
-    }
-}
-
-/// The parameters of the passes over the mirror record: full resolution, no
-/// downsampling (as `Renderer::submit_frame` writes its `mirror_params`).
-fn mirror_params(p: &FrameParams) -> FrameParams {
-    FrameParams {
-        low_width: p.width,
-        low_height: p.height,
-        downsample: 1,
-        ..*p
-    }
-}
-
 fn settings(w: u32, h: u32, a: Accelerations) -> RenderSettings {
     RenderSettings {
         width: w,
@@ -306,7 +247,7 @@ fn filter_twin_matches_the_gpu() {
             for a in filter_setups() {
                 let s = settings(w, h, a.clone());
                 r.render(&s);
-                let p = frame_params(&r.scene, &s, 0);
+                let p = r.renderer.last_params().expect("a frame");
                 let full = (w * h) as usize;
                 let low = (p.low_width * p.low_height) as usize;
                 let position = r.read("gbuffer position", full);
@@ -336,7 +277,7 @@ fn filter_twin_matches_the_gpu() {
                     ),
                 }
                 if has_mirrors && a.interleave != (1, 1) {
-                    let mp = mirror_params(&p);
+                    let mp = p.at_full_resolution();
                     let mirror_position = r.read("mirror position", full);
                     let mirror_normal = r.read("mirror normal", full);
                     let mirror_e = r.read("mirror irradiance", full);
@@ -468,7 +409,7 @@ fn compose_twin_matches_the_gpu() {
                         ..settings(w, h, a.clone())
                     };
                     r.render(&s);
-                    let p = frame_params(&r.scene, &s, 0);
+                    let p = r.renderer.last_params().expect("a frame");
                     let inputs = ComposeInputs::read(&r, &s);
                     let full = (w * h) as usize;
                     check(
@@ -494,7 +435,7 @@ fn compose_twin_matches_the_gpu() {
             check(
                 &format!("compose accumulated, {}", describe(name, &next)),
                 &r.read("color", full),
-                &inputs.compose(&frame_params(&r.scene, &next, 1), &previous),
+                &inputs.compose(&r.renderer.last_params().expect("frame 1"), &previous),
                 1e-6,
                 0.0,
             );
@@ -545,7 +486,10 @@ fn upsample_twin_matches_the_gpu() {
                     check(
                         &format!("upsample {output:?}, {}", describe(name, &s)),
                         &r.read("color", full),
-                        &inputs.compose(&frame_params(&r.scene, &s, 0), &vec![[0.0; 4]; full]),
+                        &inputs.compose(
+                            &r.renderer.last_params().expect("a frame"),
+                            &vec![[0.0; 4]; full],
+                        ),
                         1e-5,
                         0.0,
                     );
@@ -596,7 +540,7 @@ fn gather_twin_matches_the_gpu() {
                     ..settings(w, h, accelerations(ds, il, pattern, FilterMode::TwoPass))
                 };
                 r.render(&s);
-                let p = frame_params(&r.scene, &s, 0);
+                let p = r.renderer.last_params().expect("a frame");
                 let full = (w * h) as usize;
                 let low = (p.low_width * p.low_height) as usize;
                 let vpls = r.renderer.read_vpls(r.ctx).expect("vpls");
@@ -628,7 +572,7 @@ fn gather_twin_matches_the_gpu() {
                 );
                 if has_mirrors {
                     // Only the listed pixels (a mirrored hit, weight w = 1) are gathered.
-                    let mp = mirror_params(&p);
+                    let mp = p.at_full_resolution();
                     let weight = r.read("mirror weight", full);
                     let mirror_position = r.read("mirror position", full);
                     let mirror_normal = r.read("mirror normal", full);

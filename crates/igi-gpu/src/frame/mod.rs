@@ -29,7 +29,7 @@ use crate::shader::ParamsBinding;
 use crate::switches::Switches;
 use igi_core::bvh::Bvh;
 use igi_core::image::Image;
-use igi_core::sampling::{halton_base, pilot_base, DigitPermutations};
+use igi_core::sampling::{halton_base, DigitPermutations};
 use igi_core::scene::{Camera, PointLight, Scene};
 use igi_core::settings::{RenderSettings, SettingsError, MAX_MIRROR_DEPTH};
 use resources::{Buf, FrameBuffers};
@@ -141,6 +141,8 @@ pub struct Renderer {
     software: bool,
     /// Whether the next frame counts its rays (see [`Renderer::count_rays`]).
     counting: bool,
+    /// The parameters of the last submitted frame.
+    last_params: Option<FrameParams>,
 }
 
 fn permutation_buffer(ctx: &GpuContext, seed: u32) -> wgpu::Buffer {
@@ -212,6 +214,7 @@ impl Renderer {
             ray_offset_floor: igi_core::bvh::offset_floor(lo, hi),
             path_cache: None,
             counting: false,
+            last_params: None,
             software: ctx.is_software(),
             has_mirrors: scene.materials.iter().any(|m| m.mirror.max_element() > 0.0),
         };
@@ -326,6 +329,12 @@ impl Renderer {
         Ok(values)
     }
 
+    /// The parameter block of the last submitted frame (its passes over the mirrored hits
+    /// read [`FrameParams::at_full_resolution`] of it); `None` before the first frame.
+    pub fn last_params(&self) -> Option<FrameParams> {
+        self.last_params
+    }
+
     /// VPLs stored by the last submitted frame (waits for it).
     pub fn vpl_count(&self, ctx: &GpuContext) -> Result<u32, GpuError> {
         let header: Vec<u32> = ctx.read_buffer(self.buffers.get(Buf::VplHeader))?;
@@ -427,74 +436,6 @@ impl Renderer {
             self.range_buffer = Some((buffer, bind_group, count));
         }
         count
-    }
-
-    /// Light paths per frame so that the expected VPL count is `settings.vpls`: a pilot
-    /// run of [`PILOT_PATHS`] paths (a Halton window of its own) measures VPLs per path.
-    /// The count is fixed before, and independently of, the paths it is used with, and
-    /// each path carries 1/M of the power, so the estimator stays unbiased.
-    pub fn path_count(
-        &mut self,
-        ctx: &GpuContext,
-        settings: &RenderSettings,
-    ) -> Result<u32, GpuError> {
-        let key = (
-            settings.seed,
-            settings.vpls,
-            settings.bounces.max(1),
-            settings.mirror_depth,
-        );
-        if let Some((k, paths)) = self.path_cache {
-            if k == key {
-                return Ok(paths);
-            }
-        }
-        let bounces = settings.bounces.max(1);
-        self.ensure_permutations(ctx, settings.seed);
-        self.buffers
-            .ensure_vpl_slots(ctx, PILOT_PATHS as u64 * bounces as u64)?;
-        let params = self.frame_params(settings, PILOT_PATHS, pilot_base(settings.seed), 0);
-        let pilot_vpls = self.count_vpls(ctx, &params)?;
-        let per_path = pilot_vpls as f64 / PILOT_PATHS as f64;
-        let paths = if per_path > 0.0 {
-            (settings.vpls as f64 / per_path)
-                .round()
-                .clamp(1.0, u32::MAX as f64 / 64.0) as u32
-        } else {
-            // The lights reach no surface: no VPLs whatever the count.
-            settings.vpls.max(1)
-        };
-        self.path_cache = Some((key, paths));
-        Ok(paths)
-    }
-
-    /// The VPLs that the light paths of `params` leave: the VPL pass run alone, untimed
-    /// and uncounted, and its count read back (the VPL buffers must hold the paths'
-    /// slots).
-    fn count_vpls(&mut self, ctx: &GpuContext, params: &FrameParams) -> Result<u32, GpuError> {
-        let params = FrameParams {
-            count_rays: 0,
-            ..*params
-        };
-        let b = &self.buffers;
-        ctx.queue
-            .write_buffer(b.get(Buf::Params), 0, bytemuck::bytes_of(&params));
-        let bindings = VplPass::bindings(b, &self.halton_perms.1);
-        let pass = self
-            .vpl
-            .record_alone(&ctx.device, &bindings, params.path_count);
-        let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        recorder::record(
-            &mut encoder,
-            &Profiler::disabled(),
-            &self.scene,
-            &[pass],
-            &self.switches,
-            false,
-        );
-        ctx.queue.submit([encoder.finish()]);
-        let header: Vec<u32> = ctx.read_buffer(b.get(Buf::VplHeader))?;
-        Ok(header[0])
     }
 
     /// Render a frame (or `settings.accumulate` frames averaged, each with a fresh VPL set)
@@ -611,15 +552,8 @@ impl Renderer {
         settings: &RenderSettings,
         accumulate_index: u32,
     ) -> Result<(Vec<&'static str>, u32, wgpu::SubmissionIndex), GpuError> {
-        Self::check_size(ctx, settings)?;
-        check_settings(settings)?;
-        let paths = self.path_count(ctx, settings)?;
-        self.ensure_permutations(ctx, settings.seed);
+        let paths = self.prepare(ctx, settings)?;
         let bounces = settings.bounces.max(1);
-        self.buffers
-            .ensure_vpl_slots(ctx, paths as u64 * bounces as u64)?;
-        self.buffers
-            .ensure_image(ctx, settings.width, settings.height)?;
         let mut params = self.frame_params(
             settings,
             paths,
@@ -640,16 +574,12 @@ impl Renderer {
         };
         self.ensure_ranges(ctx, vpls);
         params.count_rays = self.counting as u32;
+        self.last_params = Some(params);
         let b = &self.buffers;
         ctx.queue
             .write_buffer(b.get(Buf::Params), 0, bytemuck::bytes_of(&params));
         if self.has_mirrors {
-            let mirror = FrameParams {
-                low_width: params.width,
-                low_height: params.height,
-                downsample: 1,
-                ..params
-            };
+            let mirror = params.at_full_resolution();
             ctx.queue
                 .write_buffer(b.get(Buf::MirrorParams), 0, bytemuck::bytes_of(&mirror));
         }
@@ -676,6 +606,21 @@ impl Renderer {
         Ok((names, paths, submission))
     }
 
+    /// What every frame of `settings` needs before it is recorded: the settings checked,
+    /// the light paths counted, the permutations of its seed and the frame's buffers
+    /// made. Returns the number of paths.
+    fn prepare(&mut self, ctx: &GpuContext, settings: &RenderSettings) -> Result<u32, GpuError> {
+        Self::check_size(ctx, settings)?;
+        check_settings(settings)?;
+        let paths = self.path_count(ctx, settings)?;
+        self.ensure_permutations(ctx, settings.seed);
+        let slots = paths as u64 * settings.bounces.max(1) as u64;
+        self.buffers.ensure_vpl_slots(ctx, slots)?;
+        self.buffers
+            .ensure_image(ctx, settings.width, settings.height)?;
+        Ok(paths)
+    }
+
     /// The stages of a frame of `settings`, in order, each with the passes it runs side
     /// by side (renders nothing; the frame's buffers are made if needed).
     pub fn frame_stages(
@@ -683,15 +628,8 @@ impl Renderer {
         ctx: &GpuContext,
         settings: &RenderSettings,
     ) -> Result<Vec<(&'static str, Vec<&'static str>)>, GpuError> {
-        Self::check_size(ctx, settings)?;
-        check_settings(settings)?;
-        let paths = self.path_count(ctx, settings)?;
-        let bounces = settings.bounces.max(1);
-        self.buffers
-            .ensure_vpl_slots(ctx, paths as u64 * bounces as u64)?;
-        self.buffers
-            .ensure_image(ctx, settings.width, settings.height)?;
-        self.ensure_ranges(ctx, paths as u64 * bounces as u64);
+        let paths = self.prepare(ctx, settings)?;
+        self.ensure_ranges(ctx, paths as u64 * settings.bounces.max(1) as u64);
         let passes = self.frame_passes(&ctx.device, settings, paths);
         Ok(recorder::stage_names(&passes, &self.switches))
     }

@@ -1,8 +1,14 @@
 //! The frame's parameter block (`FrameParams`, `layout.rs`) from the settings, the camera
-//! and the scene's lights.
+//! and the scene's lights, and the number of light paths a frame shoots (the pilot run).
 
-use super::{low_resolution, Renderer};
+use super::recorder;
+use super::resources::Buf;
+use super::{low_resolution, Renderer, PILOT_PATHS};
+use crate::context::{GpuContext, GpuError};
 use crate::layout::FrameParams;
+use crate::passes::vpl::VplPass;
+use crate::profiler::Profiler;
+use igi_core::sampling::pilot_base;
 use igi_core::settings::{GeometryBound, InterleavePattern, OutputBuffer, RenderSettings};
 
 impl Renderer {
@@ -84,5 +90,77 @@ impl Renderer {
             ray_offset_floor: self.ray_offset_floor,
             _pad: [0; 2],
         }
+    }
+
+    /// Light paths per frame so that the expected VPL count is `settings.vpls`: a pilot
+    /// run of [`PILOT_PATHS`] paths (a Halton window of its own) measures VPLs per path.
+    /// The count is fixed before, and independently of, the paths it is used with, and
+    /// each path carries 1/M of the power, so the estimator stays unbiased.
+    pub fn path_count(
+        &mut self,
+        ctx: &GpuContext,
+        settings: &RenderSettings,
+    ) -> Result<u32, GpuError> {
+        let key = (
+            settings.seed,
+            settings.vpls,
+            settings.bounces.max(1),
+            settings.mirror_depth,
+        );
+        if let Some((k, paths)) = self.path_cache {
+            if k == key {
+                return Ok(paths);
+            }
+        }
+        let bounces = settings.bounces.max(1);
+        self.ensure_permutations(ctx, settings.seed);
+        self.buffers
+            .ensure_vpl_slots(ctx, PILOT_PATHS as u64 * bounces as u64)?;
+        let params = self.frame_params(settings, PILOT_PATHS, pilot_base(settings.seed), 0);
+        let pilot_vpls = self.count_vpls(ctx, &params)?;
+        let per_path = pilot_vpls as f64 / PILOT_PATHS as f64;
+        let paths = if per_path > 0.0 {
+            (settings.vpls as f64 / per_path)
+                .round()
+                .clamp(1.0, u32::MAX as f64 / 64.0) as u32
+        } else {
+            // The lights reach no surface: no VPLs whatever the count.
+            settings.vpls.max(1)
+        };
+        self.path_cache = Some((key, paths));
+        Ok(paths)
+    }
+
+    /// The VPLs that the light paths of `params` leave: the VPL pass run alone, untimed
+    /// and uncounted, and its count read back (the VPL buffers must hold the paths'
+    /// slots).
+    pub(super) fn count_vpls(
+        &mut self,
+        ctx: &GpuContext,
+        params: &FrameParams,
+    ) -> Result<u32, GpuError> {
+        let params = FrameParams {
+            count_rays: 0,
+            ..*params
+        };
+        let b = &self.buffers;
+        ctx.queue
+            .write_buffer(b.get(Buf::Params), 0, bytemuck::bytes_of(&params));
+        let bindings = VplPass::bindings(b, &self.halton_perms.1);
+        let pass = self
+            .vpl
+            .record_alone(&ctx.device, &bindings, params.path_count);
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        recorder::record(
+            &mut encoder,
+            &Profiler::disabled(),
+            &self.scene,
+            &[pass],
+            &self.switches,
+            false,
+        );
+        ctx.queue.submit([encoder.finish()]);
+        let header: Vec<u32> = ctx.read_buffer(b.get(Buf::VplHeader))?;
+        Ok(header[0])
     }
 }
