@@ -5,9 +5,12 @@
 //! Files are written to a temporary name beside the target and renamed into place, so an
 //! interrupted run never leaves a half-written image.
 
+mod output_files;
+
+pub use output_files::{output_target, remove_partial_files, write_atomically, OutputFiles};
+use std::fs::File;
 use std::io::BufWriter;
 use std::path::{Path, PathBuf};
-use std::sync::{Mutex, MutexGuard};
 
 /// A linear RGB image, rows top to bottom.
 #[derive(Clone, Debug, PartialEq)]
@@ -93,14 +96,30 @@ impl Image {
     /// Read the first RGB(A) layer of an OpenEXR file (half or float) as linear RGB.
     /// A FIFO or device is refused, not read (which could block forever).
     pub fn read_exr(path: &Path) -> Result<Image, ImageError> {
+        let bytes =
+            crate::scene::loader::read_regular_file(path).map_err(|e| ImageError::Read {
+                path: path.to_path_buf(),
+                reason: e.to_string(),
+            })?;
+        Self::read_exr_bytes(&bytes, path)
+    }
+
+    /// [`Image::read_exr`] of a file's bytes already read; `path` names it in errors.
+    /// The sizes its headers declare are checked against [`MAX_EXR_PIXELS`] and against
+    /// the file's length before any pixel is allocated.
+    pub fn read_exr_bytes(bytes: &[u8], path: &Path) -> Result<Image, ImageError> {
         let err = |reason: String| ImageError::Read {
             path: path.to_path_buf(),
             reason,
         };
         use exr::prelude::{ReadChannels, ReadLayers};
-        let bytes =
-            crate::scene::loader::read_regular_file(path).map_err(|e| err(e.to_string()))?;
-        let not_exr = not_exr_reason(&bytes);
+        if let Some(reason) = not_exr_reason(bytes) {
+            return Err(ImageError::NotExr {
+                path: path.to_path_buf(),
+                reason,
+            });
+        }
+        check_exr_sizes(bytes).map_err(err)?;
         let image = exr::prelude::read()
             .no_deep_data()
             .largest_resolution_level()
@@ -114,59 +133,63 @@ impl Image {
             .first_valid_layer()
             .all_attributes()
             .from_buffered(std::io::Cursor::new(bytes))
-            .map_err(|e| match not_exr {
-                Some(reason) => ImageError::NotExr {
-                    path: path.to_path_buf(),
-                    reason,
-                },
-                None => err(e.to_string()),
-            })?;
+            .map_err(|e| err(e.to_string()))?;
         Ok(image.layer_data.channel_data.pixels)
     }
 
     /// Write float32 RGB OpenEXR (linear radiance, no exposure).
     pub fn write_exr(&self, path: &Path) -> Result<(), ImageError> {
+        write_atomically(path, |file| self.write_exr_to(file))
+    }
+
+    /// [`Image::write_exr`] into an open file (an [`OutputFiles`] output).
+    pub fn write_exr_to(&self, file: &mut File) -> Result<(), String> {
         use exr::prelude::{Encoding, LineOrder, SpecificChannels, Vec2, WritableImage};
-        write_atomically(path, |file| {
-            let channels = SpecificChannels::rgb(|Vec2(x, y): Vec2<usize>| {
-                let p = self.data[y * self.width as usize + x];
-                (p[0], p[1], p[2])
-            });
-            // The crate's default (RLE, 64 x 64 tiles) with its tiles in increasing
-            // order: the default's unspecified order writes them as the threads finish
-            // compressing, so one image made files of different bytes from run to run.
-            let encoding = Encoding {
-                line_order: LineOrder::Increasing,
-                ..Encoding::FAST_LOSSLESS
-            };
-            exr::prelude::Image::from_encoded_channels(
-                (self.width as usize, self.height as usize),
-                encoding,
-                channels,
-            )
-            .write()
-            .to_unbuffered(file)
-            .map_err(|e| e.to_string())
-        })
+        let channels = SpecificChannels::rgb(|Vec2(x, y): Vec2<usize>| {
+            let p = self.data[y * self.width as usize + x];
+            (p[0], p[1], p[2])
+        });
+        // The crate's default (RLE, 64 x 64 tiles) with its tiles in increasing
+        // order: the default's unspecified order writes them as the threads finish
+        // compressing, so one image made files of different bytes from run to run.
+        let encoding = Encoding {
+            line_order: LineOrder::Increasing,
+            ..Encoding::FAST_LOSSLESS
+        };
+        exr::prelude::Image::from_encoded_channels(
+            (self.width as usize, self.height as usize),
+            encoding,
+            channels,
+        )
+        .write()
+        .to_unbuffered(file)
+        .map_err(|e| e.to_string())
     }
 
     /// Write an 8-bit sRGB PNG of the image times `exposure` (clamped to [0, 1]).
     pub fn write_png(&self, path: &Path, exposure: f32) -> Result<(), ImageError> {
+        write_atomically(path, |file| self.write_png_to(file, exposure))
+    }
+
+    /// [`Image::write_png`] into an open file (an [`OutputFiles`] output).
+    pub fn write_png_to(&self, file: &mut File, exposure: f32) -> Result<(), String> {
         let bytes = self.to_srgb8(exposure);
-        write_atomically(path, |file| {
-            let mut encoder = png::Encoder::new(BufWriter::new(file), self.width, self.height);
-            encoder.set_color(png::ColorType::Rgb);
-            encoder.set_depth(png::BitDepth::Eight);
-            encoder.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
-            // fdeflate's fast mode: on the path-traced references at 512 x 512 and
-            // 800 x 600, 2-4 ms against 85-173 ms for the default (Balanced), for files
-            // 9-25% larger; the default took longer than an 800 x 600 frame's GPU work
-            // in `igi render` and about 8 s of a full `igi bench` table.
-            encoder.set_compression(png::Compression::Fast);
-            let mut writer = encoder.write_header().map_err(|e| e.to_string())?;
-            writer.write_image_data(&bytes).map_err(|e| e.to_string())?;
-            writer.finish().map_err(|e| e.to_string())
-        })
+        // Flushed by hand below: a BufWriter dropped unflushed drops the error of its
+        // last write (a full disk, a file-size limit) and the file would look complete.
+        let mut buffered = BufWriter::new(file);
+        let mut encoder = png::Encoder::new(&mut buffered, self.width, self.height);
+        encoder.set_color(png::ColorType::Rgb);
+        encoder.set_depth(png::BitDepth::Eight);
+        encoder.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
+        // fdeflate's fast mode: on the path-traced references at 512 x 512 and
+        // 800 x 600, 2-4 ms against 85-173 ms for the default (Balanced), for files
+        // 9-25% larger; the default took longer than an 800 x 600 frame's GPU work
+        // in `igi render` and about 8 s of a full `igi bench` table.
+        encoder.set_compression(png::Compression::Fast);
+        let mut writer = encoder.write_header().map_err(|e| e.to_string())?;
+        writer.write_image_data(&bytes).map_err(|e| e.to_string())?;
+        writer.finish().map_err(|e| e.to_string())?;
+        std::io::Write::flush(&mut buffered).map_err(|e| e.to_string())
     }
 
     /// 8-bit sRGB bytes (RGB, rows top to bottom) of the image times `exposure`.
@@ -176,6 +199,37 @@ impl Image {
             .flat_map(|p| p.map(|v| (linear_to_srgb(v * exposure) * 255.0 + 0.5) as u8))
             .collect()
     }
+}
+
+/// The most pixels one layer of an OpenEXR file may hold for igi to read it: 2^27 (a
+/// 16,384 x 8,192 image), 1.5 GiB as RGB floats, plus what the decoder holds beside.
+pub const MAX_EXR_PIXELS: u64 = 1 << 27;
+
+/// Errors where the headers of OpenEXR `bytes` declare more than igi reads or more than
+/// the file can hold, from the headers alone: a layer of more than [`MAX_EXR_PIXELS`],
+/// or more blocks than the file has room for in its offset tables (8 bytes a block), so
+/// that a small file cannot make the decoder allocate for a huge image.
+fn check_exr_sizes(bytes: &[u8]) -> Result<(), String> {
+    let meta = exr::meta::MetaData::read_from_buffered(bytes, false).map_err(|e| e.to_string())?;
+    let mut blocks = 0u64;
+    for h in &meta.headers {
+        let (w, h_px) = (h.layer_size.0 as u64, h.layer_size.1 as u64);
+        let pixels = w.saturating_mul(h_px);
+        if pixels > MAX_EXR_PIXELS {
+            return Err(format!(
+                "its header declares a {w} x {h_px} image ({pixels} pixels); igi reads at most {MAX_EXR_PIXELS}"
+            ));
+        }
+        blocks = blocks.saturating_add(h.chunk_count as u64);
+    }
+    let table = blocks.saturating_mul(8);
+    if table > bytes.len() as u64 {
+        return Err(format!(
+            "its headers declare {blocks} blocks, whose offset tables alone take {table} bytes, but the file has {}: it is cut short or damaged",
+            bytes.len()
+        ));
+    }
+    Ok(())
 }
 
 /// Why `bytes` cannot be OpenEXR at all, or `None` where they begin as OpenEXR does (its
@@ -273,148 +327,6 @@ pub fn pixel_differences(image: &Image, reference: &Image) -> Result<PixelDiffer
         pixels: image.data.len(),
         largest,
     })
-}
-
-/// The file that writing `path` replaces: `path` with its symbolic links followed (the
-/// link stays and its target gets the new contents, as a shell's `>` does), in a
-/// directory named canonically, so that two names of one file compare equal. Errors,
-/// before anything is rendered or written, where no file could be put there: a missing
-/// directory, or an existing entry that is not a regular file (a FIFO or device must not
-/// be replaced by a rename, and a directory cannot be).
-pub fn output_target(path: &Path) -> Result<PathBuf, ImageError> {
-    let err = |reason: String| ImageError::Write {
-        path: path.to_path_buf(),
-        reason,
-    };
-    // A trailing '/' names a directory: the OS would say "Not a directory" of a file
-    // there, and without one the name would be written as a file.
-    if path.as_os_str().as_encoded_bytes().ends_with(b"/") {
-        return Err(err(
-            "that names a directory (it ends in '/'); give a file name".into(),
-        ));
-    }
-    let mut target = path.to_path_buf();
-    // Linux gives up on a chain of 40 links (ELOOP); so does this.
-    for _ in 0..40 {
-        match std::fs::symlink_metadata(&target) {
-            Ok(meta) if meta.file_type().is_symlink() => {
-                let link = std::fs::read_link(&target).map_err(|e| err(e.to_string()))?;
-                target = match target.parent() {
-                    Some(dir) => dir.join(link),
-                    None => link,
-                };
-            }
-            Ok(meta) if meta.is_dir() => {
-                return Err(err(
-                    "a directory, not a regular file: give a file name".into()
-                ))
-            }
-            Ok(meta) if !meta.is_file() => {
-                return Err(err(
-                    "not a regular file (a directory, device or pipe)".into()
-                ))
-            }
-            _ => {
-                let name = target
-                    .file_name()
-                    .ok_or_else(|| err("not a file name".into()))?;
-                let dir = match target.parent() {
-                    Some(d) if !d.as_os_str().is_empty() => d,
-                    _ => Path::new("."),
-                };
-                if dir.exists() && !dir.is_dir() {
-                    return Err(err(format!(
-                        "'{}' exists and is not a directory",
-                        dir.display()
-                    )));
-                }
-                if !dir.is_dir() {
-                    return Err(err(format!("directory '{}' does not exist", dir.display())));
-                }
-                let dir = dir.canonicalize().map_err(|e| err(e.to_string()))?;
-                return Ok(dir.join(name));
-            }
-        }
-    }
-    Err(err("too many levels of symbolic links".into()))
-}
-
-/// Temporary files being written now, so that a signal handler can remove them
-/// ([`remove_partial_files`]) before the process exits.
-static PARTIAL_FILES: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
-
-fn partial_files() -> MutexGuard<'static, Vec<PathBuf>> {
-    // The list stays valid whatever a panicking holder did: each change is one push or
-    // one retain.
-    PARTIAL_FILES
-        .lock()
-        .unwrap_or_else(std::sync::PoisonError::into_inner)
-}
-
-/// Remove every temporary file [`write_atomically`] is writing, and keep any other from
-/// being created or renamed into place: for a handler of SIGINT or SIGTERM, which exits
-/// right after. Writers that get here later wait until the process is gone.
-pub fn remove_partial_files() {
-    let partial = partial_files();
-    for p in partial.iter() {
-        let _ = std::fs::remove_file(p);
-    }
-    // Held until the process exits: a writer neither creates a temporary file after the
-    // removal nor renames one that the removal missed.
-    std::mem::forget(partial);
-}
-
-/// Write through `write` to a temporary file beside the target of `path` (see
-/// [`output_target`], checked first), then rename it into place. `write` gets the file
-/// already open, so that a temporary file removed by [`remove_partial_files`] is never
-/// created again under its name.
-pub fn write_atomically(
-    path: &Path,
-    write: impl FnOnce(&mut std::fs::File) -> Result<(), String>,
-) -> Result<(), ImageError> {
-    let err = |reason: String| ImageError::Write {
-        path: path.to_path_buf(),
-        reason,
-    };
-    let target = output_target(path)?;
-    let (dir, name) = match (target.parent(), target.file_name()) {
-        (Some(dir), Some(name)) => (dir, name.to_string_lossy()),
-        _ => return Err(err("not a file name".into())),
-    };
-    // Keep the extension last: the EXR writer does not care, but tools looking at the
-    // directory meanwhile see what kind of file it is.
-    let tmp = dir.join(format!(".{name}.{}.partial", std::process::id()));
-    let mut file = {
-        let mut partial = partial_files();
-        // Anything under this name was left by a dead process that had this id.
-        let _ = std::fs::remove_file(&tmp);
-        let file = std::fs::File::options()
-            .write(true)
-            .create_new(true)
-            .open(&tmp)
-            .map_err(|e| {
-                // The directory exists (output_target checked), so "not found" means it
-                // takes no new files (/proc, /sys): the OS's words alone would say that
-                // the output itself is missing.
-                err(match e.kind() {
-                    std::io::ErrorKind::NotFound => {
-                        format!("directory '{}' takes no new files", dir.display())
-                    }
-                    _ => format!("cannot create a file in '{}': {e}", dir.display()),
-                })
-            })?;
-        partial.push(tmp.clone());
-        file
-    };
-    let written = write(&mut file);
-    drop(file);
-    let mut partial = partial_files();
-    let result = written.and_then(|()| std::fs::rename(&tmp, &target).map_err(|e| e.to_string()));
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    partial.retain(|p| p != &tmp);
-    result.map_err(err)
 }
 
 #[cfg(test)]

@@ -90,7 +90,7 @@ mod tests {
     #[test]
     fn the_context_alone_makes_no_passes_until_they_are_asked_for() {
         if let Err(e) = GpuContext::new(&AdapterChoice::Best) {
-            eprintln!("skipped: no adapter ({e})");
+            crate::note!("skipped: no adapter ({e})");
             return;
         }
         let (full, bare) = (

@@ -3,6 +3,7 @@
 pub mod bench;
 pub mod gpu_set_up;
 pub mod outputs;
+mod print;
 pub mod view;
 
 use igi_core::bvh::{Bvh, BvhBuilder};

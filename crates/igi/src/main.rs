@@ -71,7 +71,7 @@ fn parse_command_line() -> Cli {
 
 fn main() -> ExitCode {
     #[cfg(unix)]
-    start_up::quiet_on_closed_pipes();
+    start_up::errors_not_signals();
     let cli = parse_command_line();
     #[cfg(unix)]
     if !matches!(cli.command, Command::View(_)) {
@@ -80,7 +80,7 @@ fn main() -> ExitCode {
     // The first thread besides main: the environment is settled by now.
     #[cfg(unix)]
     if let Err(e) = igi::outputs::remove_partial_files_on_signals() {
-        eprintln!("error: cannot handle signals: {}", error_line(&e));
+        igi::note!("error: cannot handle signals: {}", error_line(&e));
         return ExitCode::FAILURE;
     }
     env_logger::Builder::from_env(
@@ -99,7 +99,7 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {}", error_line(&e));
+            igi::note!("error: {}", error_line(&e));
             ExitCode::FAILURE
         }
     }

@@ -1,17 +1,19 @@
-//! What the process settles before a command runs, on Unix: the action of SIGPIPE, and the
+//! What the process settles before a command runs, on Unix: the actions of SIGPIPE and
+//! SIGXFSZ, and the
 //! environment of the commands that open no window. Both run first in `main`, before any
 //! other thread exists.
 
-/// The Rust runtime ignores SIGPIPE, so that a write to a closed pipe (`igi info | head
-/// -0`, or a pager quit early) returns an error, which print! turns into a panic. Like
-/// other Unix tools, igi stops quietly there instead: the default action of SIGPIPE.
-/// Image files are written under a temporary name and renamed into place
-/// (igi_core::image), so such a stop leaves no half-written file under an output's name.
+/// Signals whose default action would kill igi mid-write, ignored so that the write fails
+/// with an error instead and the run ends with one error line and no output (see
+/// igi_core::image::OutputFiles): SIGPIPE (Rust's runtime ignores it already; a closed
+/// pipe on stdout or stderr is an error that igi's printing drops, see print.rs) and
+/// SIGXFSZ (a file-size limit, `ulimit -f`: the write fails with "File too large").
 #[cfg(unix)]
-pub fn quiet_on_closed_pipes() {
-    // SAFETY: called first in main, before any thread exists; SIG_DFL is a valid action.
+pub fn errors_not_signals() {
+    // SAFETY: called first in main, before any thread exists; SIG_IGN is a valid action.
     unsafe {
-        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+        libc::signal(libc::SIGPIPE, libc::SIG_IGN);
+        libc::signal(libc::SIGXFSZ, libc::SIG_IGN);
     }
 }
 

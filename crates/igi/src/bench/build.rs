@@ -25,9 +25,9 @@ pub fn run(scenes: &[String], runs: u32, builder: BvhBuilder, quiet: bool) -> Re
     }
     for (k, (arg, scene, load_time)) in loaded.into_iter().enumerate() {
         if k > 0 {
-            println!();
+            crate::say!();
         }
-        println!(
+        crate::say!(
             "{arg}: {} triangles (loaded in {:.0} ms)",
             scene.triangles.len(),
             load_time.as_secs_f64() * 1e3
@@ -47,7 +47,7 @@ pub fn run(scenes: &[String], runs: u32, builder: BvhBuilder, quiet: bool) -> Re
             bar.set_position(k as u64)
         });
         bar.finish_and_clear();
-        println!("{timing}");
+        crate::say!("{timing}");
     }
     Ok(())
 }

@@ -453,7 +453,7 @@ mod tests {
         if std::env::var_os("IGI_KEEP_REPORT").is_none() {
             std::fs::remove_dir_all(&dir).unwrap();
         } else {
-            eprintln!("report kept in {}", dir.display());
+            crate::note!("report kept in {}", dir.display());
         }
     }
 

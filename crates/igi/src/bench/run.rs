@@ -297,7 +297,7 @@ pub fn run(opts: &BenchOptions) -> Result<BenchResults> {
     let scene_names = scene_names(&opts.scenes);
     for (arg, name) in opts.scenes.iter().zip(&scene_names) {
         if *name != scene_name(arg) {
-            eprintln!("note: scene {arg} is named {name} in the report: its name is taken by an earlier scene");
+            crate::note!("note: scene {arg} is named {name} in the report: its name is taken by an earlier scene");
         }
     }
     for ((arg, scene, reference_path, reference), name) in inputs.into_iter().zip(scene_names) {
@@ -382,7 +382,7 @@ pub fn run(opts: &BenchOptions) -> Result<BenchResults> {
                     }
                     (Some(r), Some(p)) => {
                         bar.suspend(|| {
-                            eprintln!(
+                            crate::note!(
                                 "note: reference {} is {}x{}, the image {}x{}: no error measured",
                                 p.display(),
                                 r.width,

@@ -120,11 +120,11 @@ fn run_bench(args: &BenchArgs) -> Result<()> {
     };
     let results = igi::bench::run::run(&opts)?;
     for warning in igi::bench::report::write_all(&results, &args.out)? {
-        eprintln!("warning: {warning}");
+        igi::note!("warning: {warning}");
     }
     if !args.quiet {
-        println!("{}", igi::bench::report::to_markdown(&results));
+        igi::say!("{}", igi::bench::report::to_markdown(&results));
     }
-    eprintln!("wrote {}", args.out.join("results.json").display());
+    igi::note!("wrote {}", args.out.join("results.json").display());
     Ok(())
 }

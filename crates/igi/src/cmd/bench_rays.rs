@@ -163,7 +163,7 @@ pub fn run(args: &RaysArgs) -> Result<()> {
     let builder = args.bvh.builder.into();
     let bvh = Bvh::build_with(&scene.triangles, builder);
     let bvh_ms = t.elapsed().as_secs_f64() * 1e3;
-    eprintln!(
+    igi::note!(
         "scene {}: {} triangles, {}; adapter: {}",
         scene.source,
         scene.triangles.len(),
@@ -203,7 +203,7 @@ pub fn run(args: &RaysArgs) -> Result<()> {
         };
         if let Some(path) = &args.save {
             write_rays(path, &rays)?;
-            eprintln!("wrote {} rays to {}", rays.len(), path.display());
+            igi::note!("wrote {} rays to {}", rays.len(), path.display());
         }
         // Closest hits run one ray per thread whatever the schedule.
         let mut schedule = RaySchedule::PerThread;
@@ -223,7 +223,7 @@ pub fn run(args: &RaysArgs) -> Result<()> {
                 ScheduleArg::Auto => format!("auto: {alike:.1}% of neighbouring rays alike"),
                 _ => format!("asked; {alike:.1}% of neighbouring rays alike"),
             };
-            eprintln!("any-hit schedule: {} ({why})", schedule.name());
+            igi::note!("any-hit schedule: {} ({why})", schedule.name());
         }
         let timing = bench.trace(&ctx, &rays, query, schedule, args.runs)?;
         let mut runs = timing.runs_ms.clone();
@@ -243,7 +243,7 @@ pub fn run(args: &RaysArgs) -> Result<()> {
                 .chain(timing.distances.iter().map(|d| d.to_bits()))
                 .map(u64::from),
         );
-        println!(
+        igi::say!(
             "{name}: {} rays, {} {} ({:.1}%, answers hash {answers:016x}), median {median:.3} ms over {} runs (min {:.3}, max {:.3}): {:.3} G rays/s",
             rays.len(),
             timing.hits,

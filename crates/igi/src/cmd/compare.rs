@@ -11,18 +11,23 @@ pub fn run(image: &Path, reference: &Path) -> Result<()> {
     let (ma, mb) = (a.mean(), b.mean());
     // Five decimals as before, and the figure itself where they would round it to 0.
     if e > 0.0 && e < 5e-6 {
-        println!("relMSE {e:.5} ({e:.2e})");
+        igi::say!("relMSE {e:.5} ({e:.2e})");
     } else {
-        println!("relMSE {e:.5}");
+        igi::say!("relMSE {e:.5}");
     }
-    println!(
+    igi::say!(
         "mean {:.4} {:.4} {:.4} (reference {:.4} {:.4} {:.4})",
-        ma[0], ma[1], ma[2], mb[0], mb[1], mb[2]
+        ma[0],
+        ma[1],
+        ma[2],
+        mb[0],
+        mb[1],
+        mb[2]
     );
     let d = igi_core::image::pixel_differences(&a, &b)?;
     match d.largest {
-        None => println!("pixels differing: none of {} (the same bits)", d.pixels),
-        Some((diff, (x, y), r)) => println!(
+        None => igi::say!("pixels differing: none of {} (the same bits)", d.pixels),
+        Some((diff, (x, y), r)) => igi::say!(
             "pixels differing: {} of {}; largest difference {diff:.3e} at ({x}, {y}), where the reference is {r:.4e}",
             d.differing, d.pixels
         ),

@@ -9,7 +9,7 @@ pub fn run() -> Result<()> {
     }
     for a in &adapters {
         let mark = if Some(a.index) == best { "*" } else { " " };
-        println!(
+        igi::say!(
             "{mark} {}: {} ({}, {}, driver: {}, timestamps: {})",
             a.index,
             a.name,
@@ -19,11 +19,11 @@ pub fn run() -> Result<()> {
             if a.timestamps { "yes" } else { "no" }
         );
         if let Some(why) = &a.unusable {
-            println!("     unusable: it {why}");
+            igi::say!("     unusable: it {why}");
         }
     }
     if let Some(i) = best {
-        println!("igi would use adapter {i} (marked *); choose another with --adapter INDEX|NAME");
+        igi::say!("igi would use adapter {i} (marked *); choose another with --adapter INDEX|NAME");
     }
     Ok(())
 }

@@ -59,6 +59,14 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     // The options' errors that need no scene, before it is loaded.
     settings(&args.frame, args.exposure, None)?;
     check_render_outputs(args, None)?;
+    // Every output gets its temporary file now: a folder that takes no files is an error
+    // before the scene is loaded, and the outputs are renamed into place together.
+    let paths: Vec<&std::path::Path> = [&args.exr, &args.output]
+        .into_iter()
+        .flatten()
+        .map(|p| p.as_path())
+        .collect();
+    let mut files = igi_core::image::OutputFiles::reserve(paths.iter().copied())?;
     let gpu = igi::gpu_set_up::GpuSetUp::start(args.frame.adapter.clone())?;
     let t = Instant::now();
     let loaded = load(&args.scene).and_then(|scene| {
@@ -82,14 +90,14 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let builder = args.frame.bvh.builder.into();
     let bvh = Bvh::build_with(&scene.triangles, builder);
     let bvh_ms = t.elapsed().as_secs_f64() * 1e3;
-    eprintln!(
+    igi::note!(
         "scene {}: {} triangles, {} lights (loaded in {load_ms:.0} ms, {})",
         scene.source,
         scene.triangles.len(),
         scene.lights.len(),
         igi::bvh_built(&bvh, builder, bvh_ms)
     );
-    eprintln!("adapter: {}", ctx.describe());
+    igi::note!("adapter: {}", ctx.describe());
     let mut renderer = Renderer::with_passes(&ctx, passes, &scene, &bvh)?;
     let frame = if settings.accumulate > 1 {
         // Frames done and the time left, on a terminal (indicatif draws nothing elsewhere).
@@ -100,7 +108,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     } else {
         renderer.render(&ctx, &settings)?
     };
-    eprintln!(
+    igi::note!(
         "{}x{}: {} VPLs from {} light paths ({} asked), min_dist {:.4}",
         settings.width,
         settings.height,
@@ -111,23 +119,25 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     );
     if args.timings {
         if frame.stages.is_empty() {
-            eprintln!("timings: this adapter has no timestamp queries");
+            igi::note!("timings: this adapter has no timestamp queries");
         } else {
             for s in &frame.stages {
-                eprintln!("  {:<20} {:>9.3} ms", s.name, s.ms);
+                igi::note!("  {:<20} {:>9.3} ms", s.name, s.ms);
             }
             if let Some(ms) = frame.frame_ms {
-                eprintln!("  {:<20} {:>9.3} ms", "frame", ms);
+                igi::note!("  {:<20} {:>9.3} ms", "frame", ms);
             }
         }
     }
     if let Some(path) = &args.exr {
-        frame.image.write_exr(path)?;
-        eprintln!("wrote {}", path.display());
+        files.write(path, |file| frame.image.write_exr_to(file))?;
     }
     if let Some(path) = &args.output {
-        frame.image.write_png(path, args.exposure)?;
-        eprintln!("wrote {}", path.display());
+        files.write(path, |file| frame.image.write_png_to(file, args.exposure))?;
+    }
+    files.commit()?;
+    for path in paths {
+        igi::note!("wrote {}", path.display());
     }
     Ok(())
 }

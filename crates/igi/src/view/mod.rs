@@ -55,7 +55,7 @@ pub struct ViewOptions {
 pub fn run(opts: ViewOptions) -> Result<()> {
     let t = Instant::now();
     let bvh = Bvh::build_with(&opts.scene.triangles, opts.bvh);
-    eprintln!(
+    crate::note!(
         "scene {}: {} triangles, {} lights ({})",
         opts.scene.source,
         opts.scene.triangles.len(),
@@ -225,7 +225,7 @@ impl Viewer {
             window.clone(),
             Box::new(event_loop.owned_display_handle()),
         )?;
-        eprintln!("adapter: {}", ctx.describe());
+        crate::note!("adapter: {}", ctx.describe());
         let size = window.inner_size();
         let mut config = surface
             .get_default_config(&ctx.adapter, size.width.max(1), size.height.max(1))
@@ -485,7 +485,7 @@ impl Viewer {
 
         if self.print_camera {
             self.print_camera = false;
-            println!("{}", camera_toml(&camera));
+            crate::say!("{}", camera_toml(&camera));
             self.stats.message = Some("camera printed to the standard output".into());
         }
         if self.screenshot {
@@ -506,7 +506,7 @@ impl Viewer {
             if self.frames_rendered >= n {
                 if let Some(started) = self.started.filter(|_| n > 1) {
                     let seconds = started.elapsed().as_secs_f64();
-                    eprintln!(
+                    crate::note!(
                         "frames 2 to {n} of {width}x{height} in a {}x{} window: {:.2} fps, {:.1} ms a frame{}",
                         self.config.width,
                         self.config.height,
@@ -518,7 +518,7 @@ impl Viewer {
                     );
                 }
                 if let Some(path) = &opts.screenshot {
-                    eprintln!("{}", self.save(path)?);
+                    crate::note!("{}", self.save(path)?);
                 }
                 return Ok(true);
             }
@@ -631,12 +631,18 @@ impl Viewer {
     fn save(&self, png: &Path) -> Result<String> {
         let image: Image = self.renderer.read_image(&self.ctx)?;
         let exr = png.with_extension("exr");
-        image
-            .write_png(png, self.state.settings.exposure)
-            .with_context(|| format!("screenshot {}", png.display()))?;
-        image
-            .write_exr(&exr)
-            .with_context(|| format!("screenshot {}", exr.display()))?;
+        // Both files or neither.
+        let mut files =
+            igi_core::image::OutputFiles::reserve([png, exr.as_path()]).context("screenshot")?;
+        files
+            .write(png, |file| {
+                image.write_png_to(file, self.state.settings.exposure)
+            })
+            .context("screenshot")?;
+        files
+            .write(&exr, |file| image.write_exr_to(file))
+            .context("screenshot")?;
+        files.commit().context("screenshot")?;
         Ok(format!(
             "wrote {} and {} ({} frames accumulated)",
             png.display(),
