@@ -266,6 +266,37 @@ pub struct Bvh {
 }
 
 impl Bvh {
+    /// The nodes' boxes and the triangle rows times `factor`, a power of two (see
+    /// [`crate::trace_scale`]): exactly the BVH of the scaled triangles, since only
+    /// exponents change (boxes still hold their triangles, and the point box at +inf
+    /// that no ray hits stays at +inf).
+    pub fn scaled(&self, factor: f64) -> Bvh {
+        let s = |x: f32| (x as f64 * factor) as f32;
+        let s3 = |v: [f32; 3]| v.map(s);
+        let nodes = self
+            .nodes
+            .iter()
+            .map(|n| BvhNode {
+                a_min: s3(n.a_min),
+                a_max: s3(n.a_max),
+                b_min: s3(n.b_min),
+                b_max: s3(n.b_max),
+                ..*n
+            })
+            .collect();
+        let tri_rows = self
+            .tri_rows
+            .iter()
+            .map(|TriRow(r)| TriRow([s(r[0]), s(r[1]), s(r[2]), r[3]]))
+            .collect();
+        Bvh {
+            nodes,
+            tri_rows,
+            tri_order: self.tri_order.clone(),
+            build_stats: self.build_stats.clone(),
+        }
+    }
+
     /// Build with a binned SAH (see the `build` submodule for the rules), on all cores
     /// for large inputs; the result does not depend on the number of cores. Handles any
     /// input: no triangles (a BVH that misses everything), degenerate triangles (their

@@ -13,6 +13,7 @@ pub mod rays;
 pub mod sampling;
 pub mod scene;
 pub mod settings;
+pub mod trace_scale;
 pub mod vpl;
 
 pub use glam::{Vec3, Vec4};

@@ -17,6 +17,7 @@ use glam::Vec3;
 use igi_core::bvh::Bvh;
 use igi_core::rays::RayRecord;
 use igi_core::scene::Scene;
+use igi_core::trace_scale::TraceScale;
 
 /// Untimed runs before the timed ones, the least: they go on for at least
 /// [`WARMUP_SECONDS`](crate::profiler::WARMUP_SECONDS).
@@ -153,8 +154,27 @@ pub struct RayBench {
     tri_order: Vec<u32>,
 }
 
+/// Error unless `scene` is traced in its own coordinates ([`TraceScale`] 1): ray files
+/// hold rays in the scene's coordinates, and the ray bench measures the traversal as the
+/// frame runs it, unscaled.
+pub fn own_coordinates(scene: &Scene) -> Result<(), GpuError> {
+    let (lo, hi) = scene.bounds();
+    let scale = TraceScale::for_bounds(lo, hi);
+    if scale.is_one() {
+        return Ok(());
+    }
+    let (a, b) = igi_core::trace_scale::TRACED_RANGE;
+    Err(GpuError::Limit(format!(
+        "{}: the ray bench traces scenes in their own coordinates, whose largest magnitude must lie in [{a}, {b}); this one's is {:.3e} (igi render and igi view trace it scaled by {})",
+        scene.source,
+        lo.abs().max(hi.abs()).max_element(),
+        scale.factor
+    )))
+}
+
 impl RayBench {
     pub fn new(ctx: &GpuContext, scene: &Scene, bvh: &Bvh) -> Result<RayBench, GpuError> {
+        own_coordinates(scene)?;
         let scene_buffers = SceneBuffers::upload(ctx, scene, bvh)?;
         let switches = Switches::from_env();
         let layout = compute_layout::<RayBindings>(&ctx.device, "rays");

@@ -5,6 +5,7 @@ use crate::context::{GpuContext, GpuError};
 use crate::layout::{GpuLight, GpuMaterial, TriShading};
 use igi_core::bvh::Bvh;
 use igi_core::scene::Scene;
+use igi_core::trace_scale::TraceScale;
 
 pub struct SceneBuffers {
     pub layout: wgpu::BindGroupLayout,
@@ -86,14 +87,14 @@ pub fn storage_buffer(
     Ok(buffer)
 }
 
-/// The point lights as the GPU reads them.
-pub fn gpu_lights(lights: &[igi_core::scene::PointLight]) -> Vec<GpuLight> {
+/// The point lights as the GPU reads them, in trace coordinates (`scale`).
+pub fn gpu_lights(lights: &[igi_core::scene::PointLight], scale: TraceScale) -> Vec<GpuLight> {
     lights
         .iter()
         .map(|l| GpuLight {
-            position: l.position.to_array(),
+            position: scale.point(l.position).to_array(),
             _pad0: 0.0,
-            intensity: l.intensity.to_array(),
+            intensity: scale.intensity(l.intensity).to_array(),
             _pad1: 0.0,
         })
         .collect()
@@ -104,17 +105,20 @@ impl SceneBuffers {
         crate::passes::bindings::compute_layout::<SceneBindings>(device, "scene")
     }
 
+    /// The scene in its own coordinates (the ray bench's: its rays are in them).
     pub fn upload(ctx: &GpuContext, scene: &Scene, bvh: &Bvh) -> Result<SceneBuffers, GpuError> {
-        Self::upload_with(ctx, Self::layout(&ctx.device), scene, bvh)
+        Self::upload_with(ctx, Self::layout(&ctx.device), scene, bvh, TraceScale::ONE)
     }
 
     /// As [`SceneBuffers::upload`], bound with `layout` (made by [`SceneBuffers::layout`]:
-    /// the one the passes' pipelines were made with).
+    /// the one the passes' pipelines were made with), the lights scaled by `scale` (`bvh`
+    /// is scaled already: [`Bvh::scaled`]).
     pub fn upload_with(
         ctx: &GpuContext,
         layout: wgpu::BindGroupLayout,
         scene: &Scene,
         bvh: &Bvh,
+        scale: TraceScale,
     ) -> Result<SceneBuffers, GpuError> {
         let shading: Vec<TriShading> = bvh
             .tri_order
@@ -141,7 +145,7 @@ impl SceneBuffers {
                 _pad1: 0.0,
             })
             .collect();
-        let lights = gpu_lights(&scene.lights);
+        let lights = gpu_lights(&scene.lights, scale);
         let buffers = [
             storage_buffer(ctx, "BVH nodes", bytemuck::cast_slice(&bvh.nodes))?,
             storage_buffer(ctx, "triangle rows", bytemuck::cast_slice(&bvh.tri_rows))?,

@@ -32,6 +32,7 @@ use igi_core::image::Image;
 use igi_core::sampling::{halton_base, DigitPermutations};
 use igi_core::scene::{Camera, PointLight, Scene};
 use igi_core::settings::{RenderSettings, SettingsError, MAX_MIRROR_DEPTH};
+use igi_core::trace_scale::TraceScale;
 use resources::{Buf, FrameBuffers};
 
 /// Most stages a frame can have: every pass in a stage of its own (`IGI_SIDE_BY_SIDE=0`)
@@ -126,7 +127,12 @@ pub struct Renderer {
     range_layout: wgpu::BindGroupLayout,
     range_buffer: Option<(wgpu::Buffer, wgpu::BindGroup, u32)>,
     vpls_per_dispatch: u32,
+    /// In the scene's coordinates (what the caller sets); the frame's parameters have it
+    /// in trace coordinates.
     camera: Camera,
+    /// Scene coordinates to the coordinates the GPU traces in (see
+    /// [`igi_core::trace_scale`]); the figures below are in trace coordinates.
+    scale: TraceScale,
     /// See [`light_powers`].
     light_power_sum: f32,
     total_power: [f32; 3],
@@ -187,10 +193,26 @@ impl Renderer {
             filter,
             compose,
         } = passes;
-        let scene_buffers = SceneBuffers::upload_with(ctx, scene_layout, scene, bvh)?;
-        // One pass over the triangles for both figures of the scene's size.
+        // One pass over the triangles for the scene's size and its trace scale.
         let (lo, hi) = scene.bounds();
+        let scale = TraceScale::for_bounds(lo, hi);
+        let scaled_bvh;
+        let traced_bvh = if scale.is_one() {
+            bvh
+        } else {
+            log::info!(
+                "{}: traced at {} times its size (igi_core::trace_scale)",
+                scene.source,
+                scale.factor
+            );
+            scaled_bvh = bvh.scaled(scale.factor);
+            &scaled_bvh
+        };
+        let scene_buffers = SceneBuffers::upload_with(ctx, scene_layout, scene, traced_bvh, scale)?;
         warn_large_min_dist(scene, igi_core::scene::diagonal_of(lo, hi));
+        let (lo, hi) = (scale.point(lo), scale.point(hi));
+        let (light_power_sum, total_power) = light_powers(&scene.lights, scale);
+        check_light_power(light_power_sum, scale)?;
         let params_usage = ParamsBinding::of(device).usage() | wgpu::BufferUsages::COPY_DST;
         let renderer = Renderer {
             switches,
@@ -208,8 +230,9 @@ impl Renderer {
             list_grids: (LIST_WORKGROUPS, CHAIN_WORKGROUPS),
             halton_perms: (0, permutation_buffer(ctx, 0)),
             camera: scene.camera,
-            light_power_sum: light_powers(&scene.lights).0,
-            total_power: light_powers(&scene.lights).1,
+            scale,
+            light_power_sum,
+            total_power,
             diagonal: igi_core::scene::diagonal_of(lo, hi),
             ray_offset_floor: igi_core::bvh::offset_floor(lo, hi),
             path_cache: None,
@@ -266,10 +289,12 @@ impl Renderer {
                 self.scene.light_count
             )));
         }
-        let gpu = crate::scene_buffers::gpu_lights(lights);
+        let (sum, total) = light_powers(lights, self.scale);
+        check_light_power(sum, self.scale)?;
+        let gpu = crate::scene_buffers::gpu_lights(lights, self.scale);
         ctx.queue
             .write_buffer(&self.scene.lights, 0, bytemuck::cast_slice(&gpu));
-        (self.light_power_sum, self.total_power) = light_powers(lights);
+        (self.light_power_sum, self.total_power) = (sum, total);
         self.path_cache = None;
         Ok(())
     }
@@ -680,11 +705,24 @@ fn warn_large_min_dist(scene: &Scene, diagonal: f32) {
 
 /// What light choice and the VPLs' flux need of the lights: the sum over lights of each
 /// one's power summed over channels (in this order, as the CPU twin `igi_core::vpl`
-/// sums it), and the total power per channel.
-fn light_powers(lights: &[PointLight]) -> (f32, [f32; 3]) {
-    let sum = lights.iter().map(|l| l.power().element_sum()).sum();
-    let total = lights.iter().map(|l| l.power()).sum::<glam::Vec3>();
+/// sums it), and the total power per channel; in trace coordinates.
+fn light_powers(lights: &[PointLight], scale: TraceScale) -> (f32, [f32; 3]) {
+    let power = |l: &PointLight| scale.intensity(l.power());
+    let sum = lights.iter().map(|l| power(l).element_sum()).sum();
+    let total = lights.iter().map(power).sum::<glam::Vec3>();
     (sum, total.to_array())
+}
+
+/// Error where the lights' power in trace coordinates is past the f32 range: a scene
+/// scaled up by a large factor (a tiny scene) has its intensities scaled by its square.
+fn check_light_power(sum: f32, scale: TraceScale) -> Result<(), GpuError> {
+    if sum.is_finite() {
+        return Ok(());
+    }
+    Err(GpuError::Limit(format!(
+        "the lights' power, traced at {:e} times the scene's size (igi_core::trace_scale), is beyond the range of 32-bit floats: give the scene in larger units, or the lights less intensity",
+        scale.factor
+    )))
 }
 
 /// Reject settings the passes cannot honour, by igi-core's validation (the one the

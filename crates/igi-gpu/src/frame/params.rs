@@ -35,11 +35,9 @@ impl Renderer {
         };
         let cam = &self.camera;
         let (forward, right, up) = cam.basis();
-        let min_dist = settings
-            .min_dist
-            .unwrap_or(igi_core::settings::DEFAULT_MIN_DIST_FRACTION * self.diagonal);
+        let min_dist = self.min_dist(settings);
         FrameParams {
-            cam_eye: cam.eye.to_array(),
+            cam_eye: self.scale.point(cam.eye).to_array(),
             width: settings.width,
             cam_forward: forward.to_array(),
             height: settings.height,
@@ -90,6 +88,15 @@ impl Renderer {
             ray_offset_floor: self.ray_offset_floor,
             _pad: [0; 2],
         }
+    }
+
+    /// The bounding distance of G in trace coordinates: the settings' (in the scene's),
+    /// or the default fraction of the scene's diagonal.
+    pub(super) fn min_dist(&self, settings: &RenderSettings) -> f32 {
+        settings.min_dist.map_or(
+            igi_core::settings::DEFAULT_MIN_DIST_FRACTION * self.diagonal,
+            |m| self.scale.length(m),
+        )
     }
 
     /// Light paths per frame so that the expected VPL count is `settings.vpls`: a pilot

@@ -20,6 +20,11 @@ impl Renderer {
     ) -> Result<Vec<igi_core::rays::RayRecord>, GpuError> {
         use glam::Vec3;
         use igi_core::bvh::offset_ray_origin;
+        if !self.scale.is_one() {
+            return Err(GpuError::Limit(
+                "the frame's shadow rays are for the ray bench, which traces scenes in their own coordinates: this scene is traced scaled (igi_core::trace_scale)".into(),
+            ));
+        }
         let canonical = RenderSettings {
             accelerations: Accelerations::default(),
             accumulate: 1,
@@ -31,9 +36,7 @@ impl Renderer {
         let normals: Vec<[f32; 4]> = ctx.read_buffer(b.get(Buf::GbufNormal))?;
         let geometric: Vec<[f32; 4]> = ctx.read_buffer(b.get(Buf::GbufGeometric))?;
         let vpls = self.read_vpls(ctx)?;
-        let m = settings
-            .min_dist
-            .unwrap_or(igi_core::settings::DEFAULT_MIN_DIST_FRACTION * self.diagonal);
+        let m = self.min_dist(settings);
         let pixels: Vec<usize> = (0..(settings.width * settings.height) as usize)
             .filter(|&p| positions[p][3] > 0.0)
             .collect();
