@@ -281,7 +281,14 @@ pub enum SettingsError {
     FusedWithoutFilter { from_setup: Option<String> },
     #[error("image size {width}x{height}: both must be at least 1")]
     ImageSize { width: u32, height: u32 },
+    #[error("image size {width}x{height}: each side may be at most {MAX_IMAGE_SIDE} pixels (GPUs dispatch at most 65,535 workgroups along an axis, and the direct pass's workgroup covers 4 rows)")]
+    ImageSide { width: u32, height: u32 },
 }
+
+/// The longest side of an image igi renders: 65,535 workgroups (the dispatch limit that
+/// wgpu guarantees on every adapter) of the direct pass's tile, 8 x 4 pixels, along the
+/// shorter axis of the tile. Larger images are refused before the GPU is touched.
+pub const MAX_IMAGE_SIDE: u32 = 65_535 * 4;
 
 fn from_setup_named(option: &str, setup: &Option<String>) -> String {
     match setup {
@@ -416,6 +423,12 @@ impl RenderSettings {
     fn validate_size(&self) -> Result<(), SettingsError> {
         if self.width == 0 || self.height == 0 {
             return Err(SettingsError::ImageSize {
+                width: self.width,
+                height: self.height,
+            });
+        }
+        if self.width > MAX_IMAGE_SIDE || self.height > MAX_IMAGE_SIDE {
+            return Err(SettingsError::ImageSide {
                 width: self.width,
                 height: self.height,
             });

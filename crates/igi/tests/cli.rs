@@ -607,6 +607,31 @@ fn image_sizes_of_zero_or_beyond_the_adapter_are_clear_errors() {
 }
 
 #[test]
+fn an_image_side_past_the_dispatch_limit_is_refused_before_the_gpu() {
+    // Taller than 65,535 workgroups of 4 rows: the GPU's dispatch would fail, with an
+    // internal error, after the scene is loaded.
+    for (w, h) in [("300000", "2"), ("2", "262141")] {
+        let out = igi(&[
+            "render",
+            "--builtin",
+            "cornell-box",
+            "--width",
+            w,
+            "--height",
+            h,
+            "-o",
+            "/tmp/igi-tall.png",
+        ]);
+        assert_one_error_line(&out, &[&format!("{w}x{h}"), "at most 262140"]);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            !stderr.contains("adapter:"),
+            "the GPU was set up first: {stderr}"
+        );
+    }
+}
+
+#[test]
 fn output_where_no_file_can_be_created() {
     // /proc takes no new files, even for root (who bypasses permission bits): the case of
     // an output directory without write permission.

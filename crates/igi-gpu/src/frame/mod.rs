@@ -731,6 +731,13 @@ fn check_light_power(sum: f32, scale: TraceScale) -> Result<(), GpuError> {
 /// one here, as the frame always has.
 fn check_settings(settings: &RenderSettings) -> Result<(), GpuError> {
     let refuse = |e: SettingsError| GpuError::Limit(e.to_string());
+    let side = igi_core::settings::MAX_IMAGE_SIDE;
+    if settings.width > side || settings.height > side {
+        return Err(refuse(SettingsError::ImageSide {
+            width: settings.width,
+            height: settings.height,
+        }));
+    }
     if settings.mirror_depth > MAX_MIRROR_DEPTH {
         return Err(refuse(SettingsError::MirrorDepth(settings.mirror_depth)));
     }

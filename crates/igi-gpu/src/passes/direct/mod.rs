@@ -175,3 +175,13 @@ impl DirectPass {
         .over(shape.ranges)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    /// igi-core's largest image side is what the direct pass's tiles can dispatch.
+    #[test]
+    fn the_largest_image_side_fits_the_dispatch_limit() {
+        let tile = super::DIRECT_TILE.0.min(super::DIRECT_TILE.1);
+        assert_eq!(igi_core::settings::MAX_IMAGE_SIDE, 65_535 * tile);
+    }
+}
