@@ -69,7 +69,7 @@ use glam::Vec3;
 use serde::Deserialize;
 use toml::Spanned;
 
-use super::error::as_text;
+use super::error::{as_text, quote};
 use super::mtl::{resolve_material, undefined_material, MtlDef, MtlTable};
 use super::obj::{load_obj, Slot};
 use super::toml_file::{
@@ -275,7 +275,7 @@ pub fn load_scene_str(toml_text: &str, base_dir: &Path, name: &str) -> Result<Sc
                 Some(d) => (
                     d.get_ref().as_str(),
                     tf.at(d.span()),
-                    format!("default_material of mesh '{}'", mesh.path.get_ref()),
+                    format!("default_material of mesh '{}'", quote(mesh.path.get_ref())),
                 ),
                 None => {
                     return Err(SceneError::invalid(
@@ -311,7 +311,10 @@ pub fn load_scene_str(toml_text: &str, base_dir: &Path, name: &str) -> Result<Sc
     for mat_name in desc.materials.keys() {
         if !by_name.contains_key(mat_name) {
             resolve_material(&tf, mat_name, &desc.materials, &mtl)?;
-            log::warn!("{name}: [materials.{mat_name}] is used by no face; ignored");
+            log::warn!(
+                "{name}: [materials.{}] is used by no face; ignored",
+                quote(mat_name)
+            );
         }
     }
     if triangles.is_empty() {
@@ -377,7 +380,7 @@ fn add_gltf(
                 Some(old) if old.diffuse() != def.diffuse() || old.mirror() != def.mirror() => {
                     log::warn!(
                         "{file}: material '{}' is also defined in {} with other values; the first definition is used",
-                        m.name,
+                        quote(&m.name),
                         old.at
                     );
                 }

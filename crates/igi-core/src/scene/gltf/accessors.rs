@@ -8,7 +8,7 @@ use ::gltf::accessor::{DataType, Dimensions};
 use glam::Vec3;
 
 use super::document::{percent_decode, Warnings};
-use super::messages::{excerpt, parse};
+use super::messages::{parse, quote, quote_message};
 use super::{GltfMesh, MAX_VIEWLESS_COUNT};
 use crate::scene::loader::{read_regular_file, SceneError};
 
@@ -41,12 +41,12 @@ impl Reader {
         } else if uri.contains(':') {
             Err(format!(
                 "URI '{}' has an unsupported scheme (data:, file: and relative paths are read)",
-                excerpt(uri)
+                quote(uri)
             ))
         } else {
             percent_decode(uri)
                 .map(|p| self.dir.join(p))
-                .ok_or_else(|| format!("URI '{}' is not valid percent-encoded UTF-8", excerpt(uri)))
+                .ok_or_else(|| format!("URI '{}' is not valid percent-encoded UTF-8", quote(uri)))
         }
     }
 
@@ -72,7 +72,10 @@ impl Reader {
                         .map_err(|e| {
                             parse(
                                 &self.file,
-                                format!("buffer {i}: cannot decode its data: URI: {e}"),
+                                format!(
+                                    "buffer {i}: cannot decode its data: URI: {}",
+                                    quote_message(&e.to_string())
+                                ),
                             )
                         })?
                         .0

@@ -6,7 +6,7 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 use glam::Vec3;
 
 use super::accessors::Reader;
-use super::messages::{excerpt, fmt3, invalid, one_line};
+use super::messages::{fmt3, invalid, quote, quote_message, quote_path};
 use super::{pbr_to_material, GltfMaterial, DEFAULT_MATERIAL};
 use crate::scene::loader::SceneError;
 
@@ -23,7 +23,7 @@ impl Reader {
             (Some(i), _) => format!("gltf:{}:{i}", self.stem),
         };
         let label = match key {
-            Some(i) => format!("material {i} ('{}')", excerpt(&name)),
+            Some(i) => format!("material {i} ('{}')", quote(&name)),
             None => format!("the default material ('{DEFAULT_MATERIAL}')"),
         };
         let pbr = doc_mat.pbr_metallic_roughness();
@@ -95,7 +95,7 @@ impl Reader {
                     "{}: {label}: cannot decode baseColorTexture image {}: {}; its factor is used alone",
                     self.file,
                     image.index(),
-                    one_line(&why)
+                    quote_message(&why)
                 );
                 None
             }
@@ -125,7 +125,10 @@ impl Reader {
             Source::Uri { uri, .. } => {
                 let p = self.resolve_uri(uri)?;
                 if !p.is_file() {
-                    return Err(format!("'{}' is not a file", p.display()));
+                    return Err(format!(
+                        "'{}' is not a file",
+                        quote_path(&p.display().to_string())
+                    ));
                 }
                 file = Some(p);
             }

@@ -1,0 +1,212 @@
+//! Tests of the loaders at the edges of their contract (issue 37, "never wrong in
+//! silence"): inputs whose declared sizes would cost far more than their bytes, messages
+//! that quote huge file-provided text, valid files that were refused, and bad files that
+//! were accepted. Each test writes its own files into a temporary directory.
+
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use igi_core::scene::loader::{load_scene, SceneError};
+use igi_core::scene::Scene;
+
+#[path = "common/gltf_builder.rs"]
+mod gltf_builder;
+use gltf_builder::*;
+
+// ---------------------------------------------------------------------------------------
+// Helpers
+// ---------------------------------------------------------------------------------------
+
+/// A fresh directory under the system's temp dir, removed when dropped.
+struct TestDir(PathBuf);
+
+impl TestDir {
+    fn new(tag: &str) -> Self {
+        static COUNTER: AtomicUsize = AtomicUsize::new(0);
+        let n = COUNTER.fetch_add(1, Ordering::Relaxed);
+        let dir = std::env::temp_dir().join(format!(
+            "igi-scene-hostile-{}-{tag}-{n}",
+            std::process::id()
+        ));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).expect("create test dir");
+        TestDir(dir)
+    }
+
+    fn path(&self, name: &str) -> PathBuf {
+        self.0.join(name)
+    }
+
+    fn write(&self, name: &str, contents: impl AsRef<[u8]>) -> PathBuf {
+        let p = self.path(name);
+        std::fs::write(&p, contents).expect("write test file");
+        p
+    }
+
+    /// Writes `scene.toml` and loads it.
+    fn load(&self, toml: &str) -> Result<Scene, SceneError> {
+        load_scene(&self.write("scene.toml", toml))
+    }
+}
+
+impl Drop for TestDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+const CAMERA: &str = "[camera]
+eye = [0.0, 0.0, 5.0]
+target = [0.0, 0.0, 0.0]
+fov_y_deg = 40.0
+";
+
+const LIGHT: &str = "[[point_light]]
+position = [0.0, 0.0, 3.0]
+intensity = [1.0, 1.0, 1.0]
+";
+
+/// A scene with the test camera and light, one `[[mesh]]` per path, and `extra` TOML.
+fn scene_toml(paths: &[&str], extra: &str) -> String {
+    let meshes: String = paths
+        .iter()
+        .map(|p| format!("[[mesh]]\npath = \"{p}\"\n"))
+        .collect();
+    format!("{CAMERA}\n{LIGHT}\n{meshes}\n{extra}")
+}
+
+/// The error's message; checks that it is one line and contains `file` and `needles`.
+fn expect_err(r: Result<Scene, SceneError>, file: &str, needles: &[&str]) -> String {
+    let msg = match r {
+        Ok(s) => panic!(
+            "expected an error, the scene loaded ({} triangles)",
+            s.triangles.len()
+        ),
+        Err(e) => e.to_string(),
+    };
+    eprintln!("message: {}", &msg[..msg.len().min(2000)]);
+    assert!(
+        !msg.contains('\n') && !msg.contains('\r'),
+        "message is not one line"
+    );
+    assert!(msg.contains(file), "message does not name {file}: {msg}");
+    for n in needles {
+        assert!(msg.contains(n), "message lacks {n:?}: {msg}");
+    }
+    msg
+}
+
+// ---------------------------------------------------------------------------------------
+// Messages quote file-provided text shortened
+// ---------------------------------------------------------------------------------------
+
+/// A message that quotes `long` (made of `c`): short, with the start of the text and its
+/// full length, and never the whole text.
+fn assert_quoted_short(msg: &str, c: char, long: usize) {
+    assert!(
+        msg.chars().count() < 1000,
+        "message of {} characters",
+        msg.chars().count()
+    );
+    assert!(
+        msg.contains(&format!("({long} characters)")),
+        "message does not give the text's length: {msg}"
+    );
+    assert!(msg.contains(&c.to_string().repeat(40)), "{msg}");
+}
+
+#[test]
+fn huge_names_are_shortened_in_messages() {
+    const LONG: usize = 150_000;
+    let name = "n".repeat(LONG);
+    let dir = TestDir::new("long-names");
+    let tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+
+    // A material that is defined nowhere (the name appears twice in the message).
+    dir.write("undefined.obj", format!("{tri}usemtl {name}\nf 1 2 3\n"));
+    let msg = expect_err(
+        dir.load(&scene_toml(&["undefined.obj"], "")),
+        "undefined.obj:4",
+        &["defined nowhere"],
+    );
+    assert_quoted_short(&msg, 'n', LONG);
+
+    // A [materials.NAME] table with a bad value.
+    dir.write("m.obj", format!("{tri}usemtl m\nf 1 2 3\n"));
+    let extra = format!(
+        "[materials.m]\ndiffuse = [0.5, 0.5, 0.5]\n[materials.{name}]\ndiffuse = [2.0, 0.0, 0.0]\n"
+    );
+    let msg = expect_err(
+        dir.load(&scene_toml(&["m.obj"], &extra)),
+        "scene.toml",
+        &["must be in [0, 1]"],
+    );
+    assert_quoted_short(&msg, 'n', LONG);
+
+    // An unknown key of the scene file (the toml crate's message quotes it).
+    let msg = expect_err(
+        dir.load(&scene_toml(&["m.obj"], &format!("{name} = 1\n"))),
+        "scene.toml",
+        &["unknown field"],
+    );
+    assert_quoted_short(&msg, 'n', LONG);
+
+    // A face index that is not a number.
+    dir.write("face.obj", format!("{tri}f 1 2 {name}\n"));
+    let msg = expect_err(
+        dir.load(&scene_toml(&["face.obj"], "")),
+        "face.obj:4",
+        &["cannot read face index"],
+    );
+    assert_quoted_short(&msg, 'n', LONG);
+
+    // Paths that the files name: a mesh, a material library.
+    let msg = expect_err(
+        dir.load(&scene_toml(&[&format!("{name}.obj")], "")),
+        "cannot read mesh",
+        &[],
+    );
+    assert!(msg.chars().count() < 1000, "{msg}");
+    dir.write(
+        "lib.obj",
+        format!("mtllib {name}.mtl\n{tri}usemtl m\nf 1 2 3\n"),
+    );
+    let msg = expect_err(
+        dir.load(&scene_toml(&["lib.obj"], "")),
+        "material library",
+        &[],
+    );
+    assert!(msg.chars().count() < 1000, "{msg}");
+
+    // glTF: a material name, a required extension, a buffer URI.
+    let mut g = quad(Some(0));
+    g.material(&format!(
+        r#"{{"name": "{name}", "pbrMetallicRoughness": {{"metallicFactor": 2.0}}}}"#
+    ));
+    g.node(r#""mesh": 0"#);
+    dir.write("material.gltf", g.gltf());
+    let msg = expect_err(
+        dir.load(&scene_toml(&["material.gltf"], "")),
+        "material.gltf",
+        &["metallicFactor 2"],
+    );
+    assert_quoted_short(&msg, 'n', LONG);
+
+    let mut g = quad(None);
+    g.node(r#""mesh": 0"#);
+    let json =
+        g.json(Bin::DataUri)
+            .replacen('{', &format!(r#"{{"extensionsRequired": ["{name}"], "#), 1);
+    dir.write("extension.gltf", json);
+    let msg = expect_err(
+        dir.load(&scene_toml(&["extension.gltf"], "")),
+        "extension.gltf",
+        &["extensionsRequired"],
+    );
+    assert_quoted_short(&msg, 'n', LONG);
+
+    let json = g.json(Bin::File(&format!("{name}.bin")));
+    dir.write("uri.gltf", json);
+    let msg = expect_err(dir.load(&scene_toml(&["uri.gltf"], "")), "glTF buffer", &[]);
+    assert!(msg.chars().count() < 1000, "{msg}");
+}
