@@ -210,3 +210,44 @@ fn huge_names_are_shortened_in_messages() {
     let msg = expect_err(dir.load(&scene_toml(&["uri.gltf"], "")), "glTF buffer", &[]);
     assert!(msg.chars().count() < 1000, "{msg}");
 }
+
+// ---------------------------------------------------------------------------------------
+// Valid files that were refused
+// ---------------------------------------------------------------------------------------
+
+#[test]
+fn obj_and_mtl_with_old_mac_line_ends_load() {
+    let dir = TestDir::new("cr");
+    let mtl =
+        "newmtl red\nKd 0.5 0.1 0.1\nnewmtl mirror\nKd 0.1 0.1 0.1\nKs 0.8 0.8 0.8\nillum 3\n";
+    let obj = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nvn 0 0 1\nusemtl red\nf 1//1 2//1 3//1\nusemtl mirror\nf 2 4 3\n";
+    for (tag, end) in [("cr", "\r"), ("crlf", "\r\n"), ("lf", "\n")] {
+        dir.write("m.mtl", mtl.replace('\n', end));
+        dir.write("m.obj", obj.replace('\n', end));
+        let s = dir
+            .load(&scene_toml(&["m.obj"], ""))
+            .unwrap_or_else(|e| panic!("{tag}: {e}"));
+        assert_eq!(s.triangles.len(), 2, "{tag}");
+        let names: Vec<&str> = s.materials.iter().map(|m| m.name.as_str()).collect();
+        assert_eq!(names, ["red", "mirror"], "{tag}");
+        assert_eq!(s.materials[0].diffuse, igi_core::Vec3::new(0.5, 0.1, 0.1));
+        assert_eq!(s.materials[1].mirror, igi_core::Vec3::splat(0.8));
+        assert_eq!(
+            s.triangles[0].n[0],
+            igi_core::Vec3::Z,
+            "{tag}: the vn normal"
+        );
+    }
+    // Lone CRs, CRLFs and LFs mixed in one file; line numbers count each line end.
+    dir.write("m.mtl", mtl);
+    let mixed = "mtllib m.mtl\r\nv 0 0 0\rv 1 0 0\nv 0 1 0\r\nusemtl red\rf 1 2 3\rf 1 2 9\n";
+    dir.write("m.obj", mixed);
+    expect_err(
+        dir.load(&scene_toml(&["m.obj"], "")),
+        "m.obj:7",
+        &["face index 9 out of range"],
+    );
+    dir.write("m.obj", mixed.replace("f 1 2 9", "f 1 3 2"));
+    let s = dir.load(&scene_toml(&["m.obj"], "")).unwrap();
+    assert_eq!(s.triangles.len(), 2);
+}

@@ -230,8 +230,33 @@ pub(super) fn as_text<'a>(bytes: &'a [u8], file: &str) -> Result<&'a str, SceneE
 
 /// An OBJ or MTL file as text. A NUL byte means binary data: an error. Other bytes that
 /// are not UTF-8 (a Latin-1 comment or material name, say) are replaced by U+FFFD with a
-/// warning, as the reference converter reads these files (`errors="replace"`).
+/// warning, as the reference converter reads these files (`errors="replace"`). Lines may
+/// end in LF, CRLF or a lone CR (classic Mac OS files): a lone CR becomes an LF, because
+/// tobj and our own passes split lines at LF only, and such a file was one long line
+/// without a face.
 pub(super) fn as_lenient_text<'a>(bytes: &'a [u8], file: &str) -> Result<Cow<'a, str>, SceneError> {
+    match lone_cr_as_lf(bytes) {
+        None => lenient_text(bytes, file),
+        Some(fixed) => lenient_text(&fixed, file).map(|t| Cow::Owned(t.into_owned())),
+    }
+}
+
+/// `bytes` with every CR that is not followed by an LF turned into an LF, or `None` when
+/// there is none. One byte for one, so offsets (and line numbers) stay those of the file.
+fn lone_cr_as_lf(bytes: &[u8]) -> Option<Vec<u8>> {
+    let lone = |i: usize| bytes[i] == b'\r' && bytes.get(i + 1) != Some(&b'\n');
+    // `contains` is a fast byte search; most files have no CR or only CRLFs.
+    if !bytes.contains(&b'\r') || !(0..bytes.len()).any(lone) {
+        return None;
+    }
+    Some(
+        (0..bytes.len())
+            .map(|i| if lone(i) { b'\n' } else { bytes[i] })
+            .collect(),
+    )
+}
+
+fn lenient_text<'a>(bytes: &'a [u8], file: &str) -> Result<Cow<'a, str>, SceneError> {
     // `contains` searches bytes with memchr, many at a time, several times faster than a
     // byte loop over a large mesh; the offset is only wanted for the error.
     if bytes.contains(&0) {
