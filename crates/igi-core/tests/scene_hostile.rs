@@ -251,3 +251,92 @@ fn obj_and_mtl_with_old_mac_line_ends_load() {
     let s = dir.load(&scene_toml(&["m.obj"], "")).unwrap();
     assert_eq!(s.triangles.len(), 2);
 }
+
+/// `"extras": VALUE` added to every object of `json` that the glTF schema lets have extras
+/// and that the builder writes (the root, asset, scene, node, mesh, primitive, accessor,
+/// buffer view, buffer, material, KHR_lights_punctual light).
+fn with_extras(json: &str, value: &str) -> String {
+    let tag = format!(r#""extras": {value}, "#);
+    let mut out = json.replacen('{', &format!("{{{tag}"), 1);
+    for key in [
+        r#""asset": {"#,
+        r#""nodes": [{"#,
+        r#""primitives": [{"#,
+        r#""accessors": [{"#,
+        r#""bufferViews": [{"#,
+        r#""buffers": [{"#,
+        r#""materials": [{"#,
+        r#""meshes": [{"#,
+    ] {
+        out = out.replacen(key, &format!("{key}{tag}"), 1);
+    }
+    out = out.replacen(r#""type": "point""#, &format!(r#"{tag}"type": "point""#), 1);
+    out.replace(r#""scenes": [{"#, &format!(r#""scenes": [{{{tag}"#))
+}
+
+#[test]
+fn extras_of_any_json_type_are_accepted() {
+    let dir = TestDir::new("extras");
+    let mut g = quad(Some(0));
+    g.material(r#"{"name": "m", "pbrMetallicRoughness": {"metallicFactor": 0.0}}"#);
+    g.light(r#"{"type": "point", "intensity": 683.0}"#);
+    g.node(r#""mesh": 0, "children": [1]"#);
+    g.node(
+        r#""translation": [0.0, 0.0, 2.0], "extensions": {"KHR_lights_punctual": {"light": 0}}"#,
+    );
+    let plain = g.json(Bin::DataUri);
+    dir.write("plain.gltf", &plain);
+    let expected = dir.load(&scene_toml(&["plain.gltf"], "")).unwrap();
+    for value in [
+        "[1, 2, {\"a\": null}]",
+        "\"a string\"",
+        "null",
+        "-3.5e2",
+        "true",
+        "{\"extras\": \"nested application data\"}",
+    ] {
+        let json = with_extras(&plain, value);
+        assert!(json.matches("\"extras\"").count() >= 11, "{json}");
+        dir.write("extras.gltf", &json);
+        let s = dir
+            .load(&scene_toml(&["extras.gltf"], ""))
+            .unwrap_or_else(|e| panic!("extras {value}: {e}"));
+        assert_eq!(s.triangles, expected.triangles, "extras {value}");
+        assert_eq!(s.materials, expected.materials, "extras {value}");
+        assert_eq!(s.lights, expected.lights, "extras {value}");
+    }
+    // In a GLB too.
+    let mut glb_g = quad(None);
+    glb_g.node(r#""mesh": 0"#);
+    let glb = glb_g.glb();
+    let json_len = u32::from_le_bytes(glb[12..16].try_into().unwrap()) as usize;
+    let json = std::str::from_utf8(&glb[20..20 + json_len]).unwrap();
+    let mut new_json = with_extras(json.trim_end(), "\"s\"").into_bytes();
+    while !new_json.len().is_multiple_of(4) {
+        new_json.push(b' ');
+    }
+    let mut out = Vec::new();
+    out.extend_from_slice(&glb[..8]);
+    let total = glb.len() - json_len + new_json.len();
+    out.extend_from_slice(&(total as u32).to_le_bytes());
+    out.extend_from_slice(&(new_json.len() as u32).to_le_bytes());
+    out.extend_from_slice(b"JSON");
+    out.extend_from_slice(&new_json);
+    out.extend_from_slice(&glb[20 + json_len..]);
+    dir.write("extras.glb", out);
+    let s = dir.load(&scene_toml(&["extras.glb"], "")).unwrap();
+    assert_eq!(s.triangles.len(), 2);
+
+    // A file whose extras are fine but that has another fault still says which.
+    let bad = with_extras(&plain, "\"s\"").replacen(
+        r#""componentType": 5126"#,
+        r#""componentType": "float""#,
+        1,
+    );
+    dir.write("bad.gltf", bad);
+    expect_err(
+        dir.load(&scene_toml(&["bad.gltf"], "")),
+        "bad.gltf",
+        &["invalid glTF JSON", "\"float\""],
+    );
+}
