@@ -340,3 +340,79 @@ fn extras_of_any_json_type_are_accepted() {
         &["invalid glTF JSON", "\"float\""],
     );
 }
+
+// ---------------------------------------------------------------------------------------
+// Bad files that were accepted
+// ---------------------------------------------------------------------------------------
+
+/// The quad's positions as a sparse accessor over zeros, vertices `indices` replaced by
+/// `QUAD[1..]` (`indices` of u8, u16 or u32 as `component` 5121, 5123 or 5125 says).
+fn sparse_quad(indices: &[u32], component: u32) -> Gltf {
+    let mut g = Gltf::default();
+    let idx: Vec<u8> = match component {
+        5121 => indices.iter().map(|&x| x as u8).collect(),
+        5123 => indices
+            .iter()
+            .flat_map(|&x| (x as u16).to_le_bytes())
+            .collect(),
+        _ => indices.iter().flat_map(|x| x.to_le_bytes()).collect(),
+    };
+    let vals: Vec<u8> = QUAD[1..]
+        .iter()
+        .flatten()
+        .flat_map(|x| x.to_le_bytes())
+        .collect();
+    let (iv, vv) = (g.view(&idx), g.view(&vals));
+    let p = g.accessor(format!(
+        r#"{{"componentType": 5126, "count": 4, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0], "sparse": {{"count": 3, "indices": {{"bufferView": {iv}, "componentType": {component}}}, "values": {{"bufferView": {vv}}}}}}}"#
+    ));
+    let i = g.indices(&QUAD_INDICES);
+    g.mesh(&[primitive(p, Some(i), "")]);
+    g.node(r#""mesh": 0"#);
+    g
+}
+
+#[test]
+fn sparse_indices_out_of_order_or_range_are_refused() {
+    let dir = TestDir::new("sparse");
+    for component in [5121, 5123, 5125] {
+        // Strictly increasing and in range: the quad.
+        dir.write("ok.gltf", sparse_quad(&[1, 2, 3], component).gltf());
+        let s = dir.load(&scene_toml(&["ok.gltf"], "")).unwrap();
+        assert_eq!(s.triangles.len(), 2, "component type {component}");
+        let cases: [(&[u32], &[&str]); 4] = [
+            (
+                &[1, 3, 2],
+                &[
+                    "element 2 is 2",
+                    "not greater than element 1 (3)",
+                    "strictly increasing",
+                ],
+            ),
+            (
+                &[1, 1, 2],
+                &["element 1 is 1", "not greater than element 0 (1)"],
+            ),
+            (
+                &[3, 2, 1],
+                &["element 1 is 2", "not greater than element 0 (3)"],
+            ),
+            (
+                &[1, 2, 4],
+                &["element 2 is 4", "out of range", "4 elements"],
+            ),
+        ];
+        for (indices, needles) in cases {
+            dir.write("bad.gltf", sparse_quad(indices, component).gltf());
+            let msg = expect_err(
+                dir.load(&scene_toml(&["bad.gltf"], "")),
+                "bad.gltf",
+                needles,
+            );
+            assert!(
+                msg.contains("mesh 0 primitive 0 POSITION (accessor 0) sparse indices"),
+                "{msg}"
+            );
+        }
+    }
+}

@@ -228,6 +228,7 @@ impl Reader {
                 indices.index_type().size(),
                 &format!("{label} sparse indices"),
             )?;
+            self.check_sparse_indices(&sparse, count, &label)?;
             let values = sparse.values();
             self.check_range(
                 &values.view(),
@@ -236,6 +237,62 @@ impl Reader {
                 size,
                 &format!("{label} sparse values"),
             )?;
+        }
+        Ok(())
+    }
+
+    /// Checks that the sparse indices of an accessor of `count` elements are strictly
+    /// increasing and below `count`, as the glTF spec requires. The gltf crate's reader
+    /// walks them in step with the elements and applies only those it meets in order: an
+    /// index out of order or out of range silently left the rest of the values unapplied.
+    /// The indices' byte range is checked (`check_range`) before.
+    pub(super) fn check_sparse_indices(
+        &self,
+        sparse: &::gltf::accessor::sparse::Sparse,
+        count: usize,
+        label: &str,
+    ) -> Result<(), SceneError> {
+        let indices = sparse.indices();
+        let view = indices.view();
+        let size = indices.index_type().size();
+        let stride = view.stride().unwrap_or(size);
+        let data = self
+            .buffers
+            .get(view.buffer().index())
+            .map_or(&[][..], |d| &d.0[..]);
+        let start = view.offset().saturating_add(indices.offset());
+        let mut previous: Option<u32> = None;
+        for k in 0..sparse.count() {
+            let at = start.saturating_add(k.saturating_mul(stride));
+            let i = match data.get(at..at.saturating_add(size)) {
+                Some(&[x]) => u32::from(x),
+                Some(&[x, y]) => u32::from(u16::from_le_bytes([x, y])),
+                Some(&[x, y, z, w]) => u32::from_le_bytes([x, y, z, w]),
+                _ => {
+                    return Err(parse(
+                        &self.file,
+                        format!("{label} sparse indices: element {k} lies outside its buffer"),
+                    ))
+                }
+            };
+            if i as usize >= count {
+                return Err(parse(
+                    &self.file,
+                    format!(
+                        "{label} sparse indices: element {k} is {i}, out of range: the accessor has {count} elements"
+                    ),
+                ));
+            }
+            if let Some(p) = previous.filter(|&p| i <= p) {
+                return Err(parse(
+                    &self.file,
+                    format!(
+                        "{label} sparse indices: element {k} is {i}, not greater than element {} ({p}): the glTF spec requires strictly increasing indices",
+                        k - 1
+                    ),
+                ));
+            }
+            previous = Some(i);
         }
         Ok(())
     }
