@@ -416,3 +416,64 @@ fn sparse_indices_out_of_order_or_range_are_refused() {
         }
     }
 }
+
+/// The quad under a node of rotation `q` (x, y, z, w).
+fn rotated_quad(q: [f32; 4]) -> Vec<u8> {
+    let mut g = quad(None);
+    g.node(&format!(
+        r#""mesh": 0, "rotation": [{:?}, {:?}, {:?}, {:?}]"#,
+        q[0], q[1], q[2], q[3]
+    ));
+    g.gltf()
+}
+
+#[test]
+fn rotations_far_from_unit_length_are_refused_and_near_ones_normalised() {
+    let dir = TestDir::new("rotation");
+    let (s, c) = (0.5f32.sin(), 0.5f32.cos()); // 1 radian about z
+    dir.write("unit.gltf", rotated_quad([0.0, 0.0, s, c]));
+    let unit = dir.load(&scene_toml(&["unit.gltf"], "")).unwrap();
+    // The quad's corner (1, 0, 0) goes to (cos 1, sin 1, 0).
+    let corner = unit.triangles[0].v[1];
+    assert!((corner - igi_core::Vec3::new(1f32.cos(), 1f32.sin(), 0.0)).length() < 1e-6);
+
+    // Within the tolerance: the same rotation (normalised), not one that scales by |q|^2.
+    for k in [1.0 - 0.007, 1.0 + 0.007, 1.0 + 1e-4] {
+        dir.write("near.gltf", rotated_quad([0.0, 0.0, s * k, c * k]));
+        let near = dir.load(&scene_toml(&["near.gltf"], "")).unwrap();
+        for (a, b) in near.triangles.iter().zip(&unit.triangles) {
+            for (p, q) in a.v.iter().zip(&b.v) {
+                assert!((*p - *q).length() < 1e-6, "length {k}: {p} != {q}");
+            }
+        }
+    }
+
+    // Beyond it: an error naming the node and the length.
+    for (q, length) in [
+        ([0.0, 0.0, 0.0, 2.0], "2.000000"),
+        ([0.0, 0.0, 0.0, 0.0], "0.000000"),
+        ([0.5, 0.5, 0.5, 0.48], "0.99015"),
+        ([1.0, 1.0, 1.0, 1.0], "2.000000"),
+    ] {
+        dir.write("far.gltf", rotated_quad(q));
+        expect_err(
+            dir.load(&scene_toml(&["far.gltf"], "")),
+            "far.gltf",
+            &[
+                "node 0",
+                "rotation",
+                &format!("has length {length}"),
+                "unit quaternion",
+            ],
+        );
+    }
+    // A rotation that is not finite is refused as before.
+    let mut g = quad(None);
+    g.node(r#""mesh": 0, "rotation": [0.0, 0.0, 0.0, 1e39]"#);
+    dir.write("inf.gltf", g.gltf());
+    expect_err(
+        dir.load(&scene_toml(&["inf.gltf"], "")),
+        "inf.gltf",
+        &["node 0", "not finite"],
+    );
+}

@@ -56,6 +56,13 @@ pub const MIRROR_MAX_ROUGHNESS: f32 = 0.2;
 /// metallic 1, roughness 1, hence diffuse 1 and no mirror).
 pub const DEFAULT_MATERIAL: &str = "gltf:default";
 
+/// How far from 1 the length of a node's rotation quaternion may be: further is an error,
+/// closer is normalised. The value is the Khronos glTF-Validator's (`ROTATION_NON_UNIT`,
+/// an error there too), slightly more than the error of quaternions quantised to signed
+/// 8 bits; float rotations written with 6 or more digits are within 1e-5 of unit length,
+/// and even 3 decimals stay within 1e-3, so only a rotation that is not one is refused.
+pub const MAX_ROTATION_LENGTH_ERROR: f32 = 0.00769;
+
 /// Vertices an accessor without a buffer view (sparse values over zeros) may declare: such
 /// a count is not bounded by any buffer's size, and reading it allocates that many items.
 const MAX_VIEWLESS_COUNT: usize = 1 << 26;

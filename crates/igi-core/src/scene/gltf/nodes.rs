@@ -4,12 +4,13 @@
 use ::gltf::accessor::{DataType, Dimensions};
 use ::gltf::khr_lights_punctual::Kind as LightKind;
 use ::gltf::mesh::Mode;
+use ::gltf::scene::Transform;
 use ::gltf::Semantic;
-use glam::{Mat3, Mat4, Vec3};
+use glam::{DQuat, Mat3, Mat4, Quat, Vec3};
 
 use super::accessors::Reader;
 use super::messages::{fmt3, invalid, mesh_label, parse};
-use super::LUMENS_PER_WATT;
+use super::{LUMENS_PER_WATT, MAX_ROTATION_LENGTH_ERROR};
 use crate::scene::loader::SceneError;
 use crate::scene::{PointLight, Triangle};
 
@@ -40,8 +41,7 @@ impl Reader {
                     ),
                 ));
             }
-            let local = Mat4::from_cols_array_2d(&node.transform().matrix());
-            let world = parent * local;
+            let world = parent * self.local_matrix(&node)?;
             if !world.is_finite() {
                 return Err(invalid(
                     &self.file,
@@ -63,6 +63,48 @@ impl Reader {
             stack.extend(children.into_iter().rev().map(|c| (c, world)));
         }
         Ok(())
+    }
+
+    /// The node's local matrix: its `matrix`, or translation * rotation * scale. A rotation
+    /// whose length is further from 1 than [`MAX_ROTATION_LENGTH_ERROR`] is an error (it
+    /// would shear and scale what the node holds); one within it is normalised, so that
+    /// exporters' rounding makes an exact rotation. A rotation that is not finite is left
+    /// for the caller's check of the world matrix, which names it.
+    pub(super) fn local_matrix(&self, node: &::gltf::Node) -> Result<Mat4, SceneError> {
+        match node.transform() {
+            Transform::Matrix { matrix } => Ok(Mat4::from_cols_array_2d(&matrix)),
+            Transform::Decomposed {
+                translation,
+                rotation,
+                scale,
+            } => {
+                let q = Quat::from_array(rotation);
+                // In f64: the length of any finite f32 quaternion, without overflow.
+                let length = DQuat::from_array(rotation.map(f64::from)).length();
+                let q = if !q.is_finite() {
+                    q
+                } else if (length - 1.0).abs() <= f64::from(MAX_ROTATION_LENGTH_ERROR) {
+                    q.normalize()
+                } else {
+                    return Err(invalid(
+                        &self.file,
+                        format!(
+                            "node {}: rotation [{}, {}, {}, {}] has length {length:.6}, not 1: glTF node rotations are unit quaternions (a length within {MAX_ROTATION_LENGTH_ERROR} of 1 is normalised)",
+                            node.index(),
+                            q.x,
+                            q.y,
+                            q.z,
+                            q.w
+                        ),
+                    ));
+                };
+                Ok(Mat4::from_scale_rotation_translation(
+                    Vec3::from(scale),
+                    q,
+                    Vec3::from(translation),
+                ))
+            }
+        }
     }
 
     /// A KHR_lights_punctual light at node `node`.
