@@ -477,3 +477,105 @@ fn rotations_far_from_unit_length_are_refused_and_near_ones_normalised() {
         &["node 0", "not finite"],
     );
 }
+
+// ---------------------------------------------------------------------------------------
+// Work and memory bounded by the input's size
+// ---------------------------------------------------------------------------------------
+
+/// A mesh of `prims` primitives that all use one indices accessor of `tris` triangles of
+/// the quad's vertices, placed by `nodes` nodes: `nodes * prims * tris` triangles from a
+/// file of a few kilobytes (plus 6 bytes a triangle).
+fn instanced(nodes: usize, prims: usize, tris: usize) -> Gltf {
+    let mut g = Gltf::default();
+    let p = g.positions(&QUAD);
+    let i = g.indices(&QUAD_INDICES[..3].repeat(tris));
+    let prim = primitive(p, Some(i), "");
+    g.mesh(&vec![prim; prims]);
+    for _ in 0..nodes {
+        g.node(r#""mesh": 0"#);
+    }
+    g.roots = (0..nodes).collect();
+    g
+}
+
+#[test]
+fn node_trees_beyond_the_triangle_limit_are_refused_before_they_are_made() {
+    use igi_core::scene::loader::MAX_TRIANGLES;
+    let dir = TestDir::new("instances");
+    // 2^12 triangles x 2^6 primitives x 2^6 nodes is the limit, 2^24; one node more is
+    // past it. The file is 40 KB; before the check it made 17 M triangles (1.3 GB) and
+    // a larger such file aborted on a failed allocation.
+    let (prims, tris) = (64, 4096);
+    let nodes = MAX_TRIANGLES / (prims * tris) + 1;
+    dir.write("many.gltf", instanced(nodes, prims, tris).gltf());
+    let msg = expect_err(
+        dir.load(&scene_toml(&["many.gltf"], "")),
+        "many.gltf",
+        &[
+            &format!(
+                "its node tree would make {} triangles",
+                nodes * prims * tris
+            ),
+            &format!(
+                "mesh 0 placed by {nodes} nodes, {} triangles each",
+                prims * tris
+            ),
+            &format!("more than the {MAX_TRIANGLES} triangles a scene may have"),
+        ],
+    );
+    assert!(msg.len() < 300, "{msg}");
+
+    // Counted over the scene's meshes: two files each within the limit, not together.
+    let all = MAX_TRIANGLES / (prims * tris);
+    dir.write("one.gltf", instanced(1, prims, tris).gltf());
+    dir.write("all.gltf", instanced(all, prims, tris).gltf());
+    assert_eq!(
+        dir.load(&scene_toml(&["one.gltf"], ""))
+            .unwrap()
+            .triangles
+            .len(),
+        prims * tris
+    );
+    expect_err(
+        dir.load(&scene_toml(&["one.gltf", "all.gltf"], "")),
+        "all.gltf",
+        &[
+            &format!("would make {MAX_TRIANGLES} triangles"),
+            &format!("and the scene's earlier meshes {}", prims * tris),
+            &format!("more than the {MAX_TRIANGLES} triangles"),
+        ],
+    );
+
+    // Declared counts near the top of usize add up without overflow.
+    let mut g = Gltf::default();
+    let p = g.positions(&QUAD);
+    let iv = g.view(&[0, 0, 0, 0]);
+    let huge = g.accessor(format!(
+        r#"{{"componentType": 5125, "count": {}, "type": "SCALAR", "sparse": {{"count": 1, "indices": {{"bufferView": {iv}, "componentType": 5125}}, "values": {{"bufferView": {iv}}}}}}}"#,
+        usize::MAX
+    ));
+    g.mesh(&[primitive(p, Some(huge), ""), primitive(p, Some(huge), "")]);
+    g.node(r#""mesh": 0"#);
+    g.node(r#""mesh": 0"#);
+    g.roots = vec![0, 1];
+    dir.write("huge.gltf", g.gltf());
+    expect_err(
+        dir.load(&scene_toml(&["huge.gltf"], "")),
+        "huge.gltf",
+        &[&format!("would make {} triangles", usize::MAX)],
+    );
+
+    // A node that two parents list (a DAG, which places a subtree once per path, so a
+    // count that doubles with each level) is refused as not a tree, before any triangle.
+    let mut g = instanced(0, 1, 1);
+    g.node(r#""children": [1, 1]"#);
+    g.node(r#""children": [2, 2]"#);
+    g.node(r#""mesh": 0"#);
+    g.roots = vec![0];
+    dir.write("dag.gltf", g.gltf());
+    expect_err(
+        dir.load(&scene_toml(&["dag.gltf"], "")),
+        "dag.gltf",
+        &["node 2 is reached twice", "must be a tree"],
+    );
+}

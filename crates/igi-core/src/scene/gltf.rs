@@ -39,7 +39,7 @@ use std::path::{Path, PathBuf};
 
 use glam::Vec3;
 
-use super::loader::SceneError;
+use super::loader::{SceneError, TriangleBudget};
 use super::{PointLight, Triangle};
 use document::read;
 use messages::parse;
@@ -130,11 +130,21 @@ pub fn load_gltf(path: &Path) -> Result<GltfMesh, SceneError> {
 
 /// Reads a glTF file (JSON or GLB, told apart by the GLB magic, whatever the extension)
 /// whose content is `bytes`; `path` names it in messages and locates its external buffers
-/// and images (relative to its directory).
+/// and images (relative to its directory). Its node tree may make at most
+/// [`MAX_TRIANGLES`](crate::scene::loader::MAX_TRIANGLES) triangles.
 pub fn load_gltf_bytes(bytes: &[u8], path: &Path) -> Result<GltfMesh, SceneError> {
+    load_gltf_within(bytes, path, TriangleBudget::default())
+}
+
+/// [`load_gltf_bytes`] for a scene whose earlier meshes used part of `budget`.
+pub(super) fn load_gltf_within(
+    bytes: &[u8],
+    path: &Path,
+    budget: TriangleBudget,
+) -> Result<GltfMesh, SceneError> {
     let file = path.display().to_string();
     // A last resort: every known panic of the gltf crate is prevented by checks below.
-    match catch_unwind(AssertUnwindSafe(|| read(bytes, path, &file))) {
+    match catch_unwind(AssertUnwindSafe(|| read(bytes, path, &file, budget))) {
         Ok(result) => result,
         Err(_) => Err(parse(
             &file,

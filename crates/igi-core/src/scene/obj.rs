@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 use glam::Vec3;
 
 use super::error::{as_lenient_text, excerpt, io_message, quote, quote_path, Location, SceneError};
-use super::loader::read_regular_file;
+use super::loader::{read_regular_file, TriangleBudget};
 use super::mtl::{read_mtl, MtlTable};
 use super::Triangle;
 
@@ -271,11 +271,13 @@ pub(super) fn scan_face<'a>(
 pub(super) const NAMES_MTLLIB: &str = "\u{1}igi-usemtl-names";
 
 /// Reads one OBJ: appends its triangles (material = slot index) and its slots; reads its
-/// MTL files into `mtl`.
+/// MTL files into `mtl`. Its faces must fit in `budget` (counted before tobj reads them).
+#[allow(clippy::too_many_arguments)]
 pub(super) fn load_obj(
     bytes: &[u8],
     path: &Path,
     mesh: usize,
+    budget: TriangleBudget,
     slots: &mut Vec<Slot>,
     out: &mut Vec<Triangle>,
     mtl: &mut MtlTable,
@@ -286,6 +288,9 @@ pub(super) fn load_obj(
     let text = strip_comments(text.as_ref());
     let text = text.as_ref();
     let scan = scan_obj(text, &file)?;
+    budget.check(scan.flags.len(), &file, || {
+        format!("its faces make {} triangles", scan.flags.len())
+    })?;
     if scan.small_faces > 0 {
         log::warn!(
             "{file}: {} faces with fewer than 3 vertices ignored",

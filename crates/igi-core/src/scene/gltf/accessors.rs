@@ -10,7 +10,7 @@ use glam::Vec3;
 use super::document::{percent_decode, Warnings};
 use super::messages::{parse, quote, quote_message};
 use super::{GltfMesh, MAX_VIEWLESS_COUNT};
-use crate::scene::loader::{read_regular_file, SceneError};
+use crate::scene::loader::{read_regular_file, SceneError, TriangleBudget};
 
 pub(super) struct Reader {
     pub(super) file: String,
@@ -28,6 +28,8 @@ pub(super) struct Reader {
     /// neither `uri` nor `bufferView`, or a `bufferView` without `mimeType`), with why.
     pub(super) bad_images: HashMap<usize, &'static str>,
     pub(super) warn: Warnings,
+    /// The triangles the scene may still take (the loader's limit, less earlier meshes').
+    pub(super) budget: TriangleBudget,
 }
 
 impl Reader {

@@ -12,7 +12,7 @@ use ::gltf::Semantic;
 use super::accessors::Reader;
 use super::messages::{document_error, invalid, parse};
 use super::GltfMesh;
-use crate::scene::loader::SceneError;
+use crate::scene::loader::{SceneError, TriangleBudget};
 
 /// Decodes `%XX` escapes of a relative URI. `None` when the result is not UTF-8 (the gltf
 /// crate would panic on such a URI, so it never sees one).
@@ -141,7 +141,14 @@ pub(super) fn with_extras_as_objects(json: &[u8]) -> Option<Result<Root, ::gltf:
     (replaced > 0).then(|| from_value(value))
 }
 
-pub(super) fn read(bytes: &[u8], path: &Path, file: &str) -> Result<GltfMesh, SceneError> {
+/// Reads one glTF file (see [`super::load_gltf_bytes`]) whose triangles must fit in
+/// `budget`.
+pub(super) fn read(
+    bytes: &[u8],
+    path: &Path,
+    file: &str,
+    budget: TriangleBudget,
+) -> Result<GltfMesh, SceneError> {
     let ::gltf::Gltf { document, blob } = document(bytes, file)?;
     let mut r = Reader {
         file: file.to_string(),
@@ -156,6 +163,7 @@ pub(super) fn read(bytes: &[u8], path: &Path, file: &str) -> Result<GltfMesh, Sc
         textures: HashMap::new(),
         bad_images: image_problems(&document),
         warn: Warnings::default(),
+        budget,
     };
     r.load_buffers(&document, blob)?;
     let Some(scene) = document

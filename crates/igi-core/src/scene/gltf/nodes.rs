@@ -1,5 +1,7 @@
 //! The scene's node trees under their world matrices: the KHR_lights_punctual point
-//! lights at their nodes and each mesh primitive's triangles.
+//! lights at their nodes and each mesh primitive's triangles. The tree is walked first
+//! and the triangles it would make are counted (against the scene's limit) before any
+//! is made.
 
 use ::gltf::accessor::{DataType, Dimensions};
 use ::gltf::khr_lights_punctual::Kind as LightKind;
@@ -15,13 +17,41 @@ use crate::scene::loader::SceneError;
 use crate::scene::{PointLight, Triangle};
 
 impl Reader {
-    /// Walks the scene's node trees depth-first, each node's world matrix the product of
-    /// the local ones from its root down.
+    /// Places the scene's node trees: lights at their nodes' world positions, and each
+    /// mesh's triangles under its node's world matrix.
     pub(super) fn scene(
         &mut self,
         doc: &::gltf::Document,
         scene: &::gltf::Scene,
     ) -> Result<(), SceneError> {
+        let placed = self.world_matrices(doc, scene)?;
+        self.check_triangle_count(doc, &placed)?;
+        for (node, world) in &placed {
+            if let Some(mesh) = node.mesh() {
+                if node.skin().is_some() || mesh.primitives().any(|p| p.morph_targets().len() > 0) {
+                    self.warn.skinned_or_morphed += 1;
+                }
+                for prim in mesh.primitives() {
+                    self.primitive(&mesh, &prim, world)?;
+                }
+            }
+            if let Some(light) = node.light() {
+                self.light(&light, node.index(), world)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// The nodes of the scene's trees that hold a mesh or a light, depth-first, each with
+    /// its world matrix (the product of the local ones from its root down). Each node is
+    /// visited once: a node reached twice (a cycle, or a node with two parents, which
+    /// would place its subtree once per path, a count that doubles with each level) is
+    /// an error.
+    fn world_matrices<'a>(
+        &self,
+        doc: &'a ::gltf::Document,
+        scene: &::gltf::Scene<'a>,
+    ) -> Result<Vec<(::gltf::Node<'a>, Mat4)>, SceneError> {
         // An explicit stack (no recursion, so a deep file cannot overflow ours) and a
         // visited mark (the crate does not reject cycles, which would never end).
         let mut seen = vec![false; doc.nodes().len()];
@@ -30,6 +60,7 @@ impl Reader {
             .map(|n| (n, Mat4::IDENTITY))
             .collect::<Vec<_>>();
         stack.reverse();
+        let mut placed = Vec::new();
         while let Some((node, parent)) = stack.pop() {
             let i = node.index();
             if std::mem::replace(&mut seen[i], true) {
@@ -48,21 +79,55 @@ impl Reader {
                     format!("node {i}: its transform (or a parent's) is not finite"),
                 ));
             }
-            if let Some(mesh) = node.mesh() {
-                if node.skin().is_some() || mesh.primitives().any(|p| p.morph_targets().len() > 0) {
-                    self.warn.skinned_or_morphed += 1;
-                }
-                for prim in mesh.primitives() {
-                    self.primitive(&mesh, &prim, &world)?;
-                }
-            }
-            if let Some(light) = node.light() {
-                self.light(&light, i, &world)?;
-            }
             let children: Vec<_> = node.children().collect();
             stack.extend(children.into_iter().rev().map(|c| (c, world)));
+            if node.mesh().is_some() || node.light().is_some() {
+                placed.push((node, world));
+            }
         }
-        Ok(())
+        Ok(placed)
+    }
+
+    /// Refuses a tree whose meshes would make more triangles than the scene may still take,
+    /// before any is made: the count comes from the accessors' declared counts (degenerate
+    /// triangles, dropped later, count too: they cost the same work), summed without
+    /// overflow. A file of a few kilobytes that places one mesh at many nodes could
+    /// otherwise ask for billions of triangles.
+    fn check_triangle_count(
+        &self,
+        doc: &::gltf::Document,
+        placed: &[(::gltf::Node, Mat4)],
+    ) -> Result<(), SceneError> {
+        // Per mesh: its triangles, and how many nodes place it.
+        let mut per_mesh: Vec<(usize, usize)> = vec![(0, 0); doc.meshes().len()];
+        let mut total = 0usize;
+        for mesh in placed.iter().filter_map(|(node, _)| node.mesh()) {
+            let Some(entry) = per_mesh.get_mut(mesh.index()) else {
+                continue;
+            };
+            if entry.1 == 0 {
+                entry.0 = mesh
+                    .primitives()
+                    .map(|p| primitive_triangles(&p))
+                    .fold(0, usize::saturating_add);
+            }
+            entry.1 += 1;
+            total = total.saturating_add(entry.0);
+        }
+        self.budget.check(total, &self.file, || {
+            let most = per_mesh
+                .iter()
+                .enumerate()
+                .max_by_key(|(_, (t, n))| t.saturating_mul(*n));
+            let detail = match most.and_then(|(m, &(t, n))| Some((doc.meshes().nth(m)?, t, n))) {
+                Some((mesh, t, n)) if n > 1 => format!(
+                    " ({} placed by {n} nodes, {t} triangles each)",
+                    mesh_label(&mesh)
+                ),
+                _ => String::new(),
+            };
+            format!("its node tree would make {total} triangles{detail}")
+        })
     }
 
     /// The node's local matrix: its `matrix`, or translation * rotation * scale. A rotation
@@ -293,6 +358,20 @@ impl Reader {
         }
         self.out.materials[material].triangles += count;
         Ok(())
+    }
+}
+
+/// The triangles a primitive makes, from its accessors' declared counts (nothing is
+/// read): what [`triangulate`] would give.
+fn primitive_triangles(prim: &::gltf::Primitive) -> usize {
+    let n = match prim.indices() {
+        Some(acc) => acc.count(),
+        None => prim.get(&Semantic::Positions).map_or(0, |acc| acc.count()),
+    };
+    match prim.mode() {
+        Mode::Triangles => n / 3,
+        Mode::TriangleStrip | Mode::TriangleFan => n.saturating_sub(2),
+        _ => 0,
     }
 }
 
