@@ -579,3 +579,51 @@ fn node_trees_beyond_the_triangle_limit_are_refused_before_they_are_made() {
         &["node 2 is reached twice", "must be a tree"],
     );
 }
+
+#[test]
+fn accessors_without_a_buffer_view_are_bounded() {
+    use igi_core::scene::gltf::MAX_VIEWLESS_ELEMENTS;
+    let dir = TestDir::new("viewless");
+    // POSITION without a buffer view: zeros, with one sparse value.
+    let viewless = |g: &mut Gltf, count: usize| {
+        let (iv, vv) = (g.view(&[0, 0, 0, 0]), g.view(&[0; 12]));
+        g.accessor(format!(
+            r#"{{"componentType": 5126, "count": {count}, "type": "VEC3", "min": [0, 0, 0], "max": [0, 0, 0], "sparse": {{"count": 1, "indices": {{"bufferView": {iv}, "componentType": 5125}}, "values": {{"bufferView": {vv}}}}}}}"#
+        ))
+    };
+    let mut g = Gltf::default();
+    let p = viewless(&mut g, MAX_VIEWLESS_ELEMENTS + 1);
+    let i = g.indices(&QUAD_INDICES);
+    g.mesh(&[primitive(p, Some(i), "")]);
+    g.node(r#""mesh": 0"#);
+    dir.write("big.gltf", g.gltf());
+    expect_err(
+        dir.load(&scene_toml(&["big.gltf"], "")),
+        "big.gltf",
+        &[
+            "mesh 0 primitive 0 POSITION (accessor 0)",
+            &format!("no bufferView and a count of {}", MAX_VIEWLESS_ELEMENTS + 1),
+            &format!("at most {MAX_VIEWLESS_ELEMENTS} of their elements"),
+        ],
+    );
+
+    // Two such accessors within the limit each, beyond it together.
+    let mut g = Gltf::default();
+    let a = viewless(&mut g, MAX_VIEWLESS_ELEMENTS / 2 + 1);
+    let b = viewless(&mut g, MAX_VIEWLESS_ELEMENTS / 2 + 1);
+    let i = g.indices(&QUAD_INDICES);
+    g.mesh(&[primitive(a, Some(i), ""), primitive(b, Some(i), "")]);
+    g.node(r#""mesh": 0"#);
+    dir.write("two.gltf", g.gltf());
+    expect_err(
+        dir.load(&scene_toml(&["two.gltf"], "")),
+        "two.gltf",
+        &[
+            "primitive 1 POSITION (accessor 1)",
+            &format!(
+                "{} of them taken by the accessors read before",
+                MAX_VIEWLESS_ELEMENTS / 2 + 1
+            ),
+        ],
+    );
+}

@@ -41,6 +41,7 @@ use glam::Vec3;
 
 use super::loader::{SceneError, TriangleBudget};
 use super::{PointLight, Triangle};
+use accessors::ReadStats;
 use document::read;
 use messages::parse;
 
@@ -63,9 +64,11 @@ pub const DEFAULT_MATERIAL: &str = "gltf:default";
 /// and even 3 decimals stay within 1e-3, so only a rotation that is not one is refused.
 pub const MAX_ROTATION_LENGTH_ERROR: f32 = 0.00769;
 
-/// Vertices an accessor without a buffer view (sparse values over zeros) may declare: such
-/// a count is not bounded by any buffer's size, and reading it allocates that many items.
-const MAX_VIEWLESS_COUNT: usize = 1 << 26;
+/// Elements that the accessors without a buffer view (zeros, or sparse values over zeros)
+/// of one file may declare in all (1,048,576: 12 MiB as positions). Such a count is paid
+/// for by no bytes of the file, so a 1.5 KB file could ask for gigabytes; real files use
+/// them for small sparse edits (mostly of morph targets, which are not read).
+pub const MAX_VIEWLESS_ELEMENTS: usize = 1 << 20;
 
 /// How many validation problems a message lists before "(and N more)".
 const MAX_LISTED: usize = 3;
@@ -142,6 +145,15 @@ pub(super) fn load_gltf_within(
     path: &Path,
     budget: TriangleBudget,
 ) -> Result<GltfMesh, SceneError> {
+    load_counted(bytes, path, budget).map(|(mesh, _)| mesh)
+}
+
+/// [`load_gltf_within`], with what reading took.
+fn load_counted(
+    bytes: &[u8],
+    path: &Path,
+    budget: TriangleBudget,
+) -> Result<(GltfMesh, ReadStats), SceneError> {
     let file = path.display().to_string();
     // A last resort: every known panic of the gltf crate is prevented by checks below.
     match catch_unwind(AssertUnwindSafe(|| read(bytes, path, &file, budget))) {
@@ -152,6 +164,11 @@ pub(super) fn load_gltf_within(
         )),
     }
 }
+
+/// The glTF builder of the integration tests, for the tests below.
+#[cfg(test)]
+#[path = "../../tests/common/gltf_builder.rs"]
+mod test_builder;
 
 #[cfg(test)]
 mod tests {
@@ -189,6 +206,78 @@ mod tests {
         assert_eq!(srgb_to_linear(0.0), 0.0);
         assert!((srgb_to_linear(1.0) - 1.0).abs() < 1e-6);
         assert!((srgb_to_linear(0.5) - 0.214_041).abs() < 1e-5);
+    }
+
+    use super::test_builder as builder;
+    use builder::{quad, Gltf, QUAD_INDICES};
+
+    /// Loads `g` (as `name` in a temp dir holding `files`), with what reading took.
+    fn load_counting(g: &Gltf, files: &[(&str, &[u8])]) -> (GltfMesh, ReadStats) {
+        let dir = std::env::temp_dir().join(format!("igi-gltf-unit-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        for (name, bytes) in files {
+            std::fs::write(dir.join(name), bytes).unwrap();
+        }
+        let r = load_counted(&g.gltf(), &dir.join("t.gltf"), TriangleBudget::default());
+        r.unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    #[test]
+    fn accessors_shared_by_nodes_and_primitives_are_read_once() {
+        // The quad with normals, placed by 40 nodes; a second mesh whose two primitives
+        // share the quad's POSITION and indices.
+        let mut g = quad(None);
+        let n = g.normals(&[[0.0, 0.0, 1.0]; 4]);
+        g.meshes[0] = g.meshes[0].replace(
+            r#""POSITION": 0"#,
+            &format!(r#""POSITION": 0, "NORMAL": {n}"#),
+        );
+        g.mesh(&[
+            builder::primitive(0, Some(1), ""),
+            builder::primitive(0, Some(1), r#", "mode": 4"#),
+        ]);
+        let nodes = 40;
+        for k in 0..nodes {
+            g.node(&format!(r#""mesh": 0, "translation": [{k}.0, 0.0, 0.0]"#));
+        }
+        g.node(r#""mesh": 1"#);
+        g.roots = (0..=nodes).collect();
+        let (mesh, stats) = load_counting(&g, &[]);
+        assert_eq!(mesh.triangles.len(), 2 * (nodes + 2));
+        assert_eq!(
+            stats.accessors_read, 3,
+            "POSITION, NORMAL and indices, once each"
+        );
+        // Each node's copy is where its node puts it.
+        for k in 0..nodes {
+            assert_eq!(
+                mesh.triangles[2 * k].v[1],
+                Vec3::new(k as f32 + 1.0, 0.0, 0.0)
+            );
+        }
+
+        // A sparse accessor without a buffer view used by many nodes: read once too.
+        let mut g = Gltf::default();
+        let idx: Vec<u8> = [1u16, 2, 3].iter().flat_map(|x| x.to_le_bytes()).collect();
+        let vals: Vec<u8> = [[1.0f32, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]]
+            .iter()
+            .flatten()
+            .flat_map(|x| x.to_le_bytes())
+            .collect();
+        let (iv, vv) = (g.view(&idx), g.view(&vals));
+        let count = MAX_VIEWLESS_ELEMENTS / 2;
+        let p = g.accessor(format!(
+            r#"{{"componentType": 5126, "count": {count}, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0], "sparse": {{"count": 3, "indices": {{"bufferView": {iv}, "componentType": 5123}}, "values": {{"bufferView": {vv}}}}}}}"#
+        ));
+        let i = g.indices(&QUAD_INDICES);
+        g.mesh(&[builder::primitive(p, Some(i), "")]);
+        for _ in 0..nodes {
+            g.node(r#""mesh": 0"#);
+        }
+        g.roots = (0..nodes).collect();
+        let (mesh, stats) = load_counting(&g, &[]);
+        assert_eq!(mesh.triangles.len(), 2 * nodes);
+        assert_eq!(stats.accessors_read, 2);
     }
 
     #[test]

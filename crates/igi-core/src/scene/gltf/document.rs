@@ -9,7 +9,7 @@ use ::gltf::json::deserialize::{from_slice, from_value};
 use ::gltf::json::{Root, Value};
 use ::gltf::Semantic;
 
-use super::accessors::Reader;
+use super::accessors::{ReadStats, Reader, Shared};
 use super::messages::{document_error, invalid, parse};
 use super::GltfMesh;
 use crate::scene::loader::{SceneError, TriangleBudget};
@@ -142,13 +142,13 @@ pub(super) fn with_extras_as_objects(json: &[u8]) -> Option<Result<Root, ::gltf:
 }
 
 /// Reads one glTF file (see [`super::load_gltf_bytes`]) whose triangles must fit in
-/// `budget`.
+/// `budget`; with what reading it took.
 pub(super) fn read(
     bytes: &[u8],
     path: &Path,
     file: &str,
     budget: TriangleBudget,
-) -> Result<GltfMesh, SceneError> {
+) -> Result<(GltfMesh, ReadStats), SceneError> {
     let ::gltf::Gltf { document, blob } = document(bytes, file)?;
     let mut r = Reader {
         file: file.to_string(),
@@ -164,6 +164,8 @@ pub(super) fn read(
         bad_images: image_problems(&document),
         warn: Warnings::default(),
         budget,
+        shared: Shared::default(),
+        stats: ReadStats::default(),
     };
     r.load_buffers(&document, blob)?;
     let Some(scene) = document
@@ -174,7 +176,7 @@ pub(super) fn read(
     };
     r.scene(&document, &scene)?;
     r.warn.log(file);
-    Ok(r.out)
+    Ok((r.out, r.stats))
 }
 
 /// Images that `Image::source()` of gltf 1.4 would `unwrap()` a `None` of: it assumes a

@@ -1,9 +1,10 @@
 //! The scene's node trees under their world matrices: the KHR_lights_punctual point
 //! lights at their nodes and each mesh primitive's triangles. The tree is walked first
 //! and the triangles it would make are counted (against the scene's limit) before any
-//! is made.
+//! is made; each primitive's data is read once, then placed at every node that uses it.
 
-use ::gltf::accessor::{DataType, Dimensions};
+use std::rc::Rc;
+
 use ::gltf::khr_lights_punctual::Kind as LightKind;
 use ::gltf::mesh::Mode;
 use ::gltf::scene::Transform;
@@ -15,6 +16,16 @@ use super::messages::{fmt3, invalid, mesh_label, parse};
 use super::{LUMENS_PER_WATT, MAX_ROTATION_LENGTH_ERROR};
 use crate::scene::loader::SceneError;
 use crate::scene::{PointLight, Triangle};
+
+/// A primitive's data as every node that places it uses it: its vertices, its triangles
+/// (vertex indices, checked to be in range, of vertices checked to be finite) and its
+/// material (an index in `out.materials`).
+pub(super) struct Prepared {
+    positions: Rc<[Vec3]>,
+    normals: Option<Rc<[Vec3]>>,
+    corners: Vec<[u32; 3]>,
+    material: usize,
+}
 
 impl Reader {
     /// Places the scene's node trees: lights at their nodes' world positions, and each
@@ -32,7 +43,9 @@ impl Reader {
                     self.warn.skinned_or_morphed += 1;
                 }
                 for prim in mesh.primitives() {
-                    self.primitive(&mesh, &prim, world)?;
+                    if let Some(prepared) = self.prepare(&mesh, &prim)? {
+                        self.place(&prepared, world);
+                    }
                 }
             }
             if let Some(light) = node.light() {
@@ -207,13 +220,17 @@ impl Reader {
         Ok(())
     }
 
-    /// One primitive of `mesh` under the world matrix `world`: appends its triangles.
-    pub(super) fn primitive(
+    /// The data of one primitive of `mesh`, read and checked on its first use; `None` for
+    /// a primitive that makes no triangles (POINTS, LINES*: skipped with a warning).
+    pub(super) fn prepare(
         &mut self,
         mesh: &::gltf::Mesh,
         prim: &::gltf::Primitive,
-        world: &Mat4,
-    ) -> Result<(), SceneError> {
+    ) -> Result<Option<Rc<Prepared>>, SceneError> {
+        let key = (mesh.index(), prim.index());
+        if let Some(p) = self.shared.primitives.get(&key) {
+            return Ok(p.clone());
+        }
         let what = format!("{} primitive {}", mesh_label(mesh), prim.index());
         let mode = prim.mode();
         if !matches!(
@@ -221,25 +238,14 @@ impl Reader {
             Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
         ) {
             self.warn.not_triangles += 1;
-            return Ok(());
+            self.shared.primitives.insert(key, None);
+            return Ok(None);
         }
         let Some(pos_acc) = prim.get(&Semantic::Positions) else {
             return Err(parse(&self.file, format!("{what} has no POSITION")));
         };
-        self.check_accessor(
-            &pos_acc,
-            &format!("{what} POSITION"),
-            &[DataType::F32],
-            Dimensions::Vec3,
-        )?;
         let nrm_acc = prim.get(&Semantic::Normals);
         if let Some(acc) = &nrm_acc {
-            self.check_accessor(
-                acc,
-                &format!("{what} NORMAL"),
-                &[DataType::F32],
-                Dimensions::Vec3,
-            )?;
             if acc.count() != pos_acc.count() {
                 return Err(parse(
                     &self.file,
@@ -251,60 +257,59 @@ impl Reader {
                 ));
             }
         }
-        if let Some(acc) = prim.indices() {
-            self.check_accessor(
-                &acc,
-                &format!("{what} indices"),
-                &[DataType::U8, DataType::U16, DataType::U32],
-                Dimensions::Scalar,
-            )?;
-        }
-
-        let buffers = &self.buffers;
-        let reader = prim.reader(|b| buffers.get(b.index()).map(|d| d.0.as_slice()));
-        let internal = |of: &str| {
-            parse(
-                &self.file,
-                format!("{what}: internal error: cannot read the {of} accessor"),
-            )
-        };
-        let positions: Vec<Vec3> = reader
-            .read_positions()
-            .ok_or_else(|| internal("POSITION"))?
-            .map(Vec3::from)
-            .collect();
-        let normals: Option<Vec<Vec3>> = match &nrm_acc {
-            Some(_) => Some(
-                reader
-                    .read_normals()
-                    .ok_or_else(|| internal("NORMAL"))?
-                    .map(Vec3::from)
-                    .collect(),
-            ),
+        let positions = self.vec3s(&pos_acc, &format!("{what} POSITION"))?;
+        let normals = match &nrm_acc {
+            Some(acc) => Some(self.vec3s(acc, &format!("{what} NORMAL"))?),
             None => None,
         };
-        let indices: Vec<u32> = match prim.indices() {
-            Some(_) => reader
-                .read_indices()
-                .ok_or_else(|| internal("indices"))?
-                .into_u32()
-                .collect(),
-            None => (0..positions.len() as u32).collect(),
-        };
         let nv = positions.len();
-        if let Some((k, &i)) = indices.iter().enumerate().find(|(_, &i)| i as usize >= nv) {
-            return Err(parse(
-                &self.file,
-                format!("{what}: index {i} (element {k} of the indices) out of range: POSITION has {nv} vertices"),
-            ));
-        }
-
-        let corners = triangulate(mode, &indices);
-        if mode == Mode::Triangles && !indices.len().is_multiple_of(3) {
-            self.warn.leftover_indices += 1;
+        let corners = match prim.indices() {
+            Some(acc) => {
+                let indices = self.indices(&acc, &format!("{what} indices"))?;
+                if let Some((k, &i)) = indices.iter().enumerate().find(|(_, &i)| i as usize >= nv) {
+                    return Err(parse(
+                        &self.file,
+                        format!("{what}: index {i} (element {k} of the indices) out of range: POSITION has {nv} vertices"),
+                    ));
+                }
+                if mode == Mode::Triangles && !indices.len().is_multiple_of(3) {
+                    self.warn.leftover_indices += 1;
+                }
+                triangulate(mode, &indices)
+            }
+            None => {
+                // Vertex counts fit in u32: the scene's triangle limit was checked first.
+                let in_order: Vec<u32> = (0..nv as u32).collect();
+                if mode == Mode::Triangles && !nv.is_multiple_of(3) {
+                    self.warn.leftover_indices += 1;
+                }
+                triangulate(mode, &in_order)
+            }
+        };
+        for t in &corners {
+            if let Some(&i) = t.iter().find(|&&i| !positions[i as usize].is_finite()) {
+                return Err(invalid(
+                    &self.file,
+                    format!(
+                        "{what}: a triangle uses vertex {i} whose position {} is not finite",
+                        fmt3(positions[i as usize].into())
+                    ),
+                ));
+            }
         }
         let material = self.material(prim.material())?;
+        let prepared = Rc::new(Prepared {
+            positions,
+            normals,
+            corners,
+            material,
+        });
+        self.shared.primitives.insert(key, Some(prepared.clone()));
+        Ok(Some(prepared))
+    }
 
+    /// Appends the triangles of a primitive under the world matrix `world`.
+    pub(super) fn place(&mut self, p: &Prepared, world: &Mat4) {
         // Normals go through the cofactor matrix, det * M^-T: defined even when M is
         // singular, and with the sign of det undone it is the inverse transpose's direction.
         let m3 = Mat3::from_mat4(*world);
@@ -317,31 +322,20 @@ impl Reader {
         }
 
         let mut count = 0usize;
-        for mut t in corners {
+        for &(mut t) in &p.corners {
             if mirrored {
                 // The glTF spec: a negative determinant makes front faces clockwise; keep
                 // the geometric normal on the side of the (inverse transposed) normals.
                 t.swap(1, 2);
             }
-            let local = t.map(|i| positions[i as usize]);
-            if let Some(k) = (0..3).find(|&k| !local[k].is_finite()) {
-                return Err(invalid(
-                    &self.file,
-                    format!(
-                        "{what}: a triangle uses vertex {} whose position {} is not finite",
-                        t[k],
-                        fmt3(local[k].into())
-                    ),
-                ));
-            }
-            let v = local.map(|p| world.transform_point3(p));
-            // A world transform may still make a vertex non-finite: then it is dropped too.
+            let v = t.map(|i| world.transform_point3(p.positions[i as usize]));
+            // A world transform may make a vertex non-finite: then it is dropped too.
             let Some(ng) = crate::scene::geometric_normal(&v) else {
                 self.warn.degenerate += 1;
                 continue;
             };
             let mut n = [ng; 3];
-            if let Some(normals) = &normals {
+            if let Some(normals) = &p.normals {
                 for (k, nk) in n.iter_mut().enumerate() {
                     match (normal_matrix * normals[t[k] as usize]).try_normalize() {
                         Some(x) => *nk = x,
@@ -352,12 +346,11 @@ impl Reader {
             self.out.triangles.push(Triangle {
                 v,
                 n,
-                material: material as u32,
+                material: p.material as u32,
             });
             count += 1;
         }
-        self.out.materials[material].triangles += count;
-        Ok(())
+        self.out.materials[p.material].triangles += count;
     }
 }
 
