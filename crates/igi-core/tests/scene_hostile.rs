@@ -627,3 +627,34 @@ fn accessors_without_a_buffer_view_are_bounded() {
         ],
     );
 }
+
+#[test]
+fn an_image_named_by_many_entries_is_read_once() {
+    let dir = TestDir::new("images");
+    dir.write("t.png", PNG);
+    // 600 image entries naming one PNG, each the texture of its own material.
+    let n = 600;
+    let mut g = Gltf::default();
+    let p = g.positions(&QUAD);
+    let i = g.indices(&QUAD_INDICES);
+    let prims: Vec<String> = (0..n)
+        .map(|k| {
+            g.images.push(r#"{"uri": "t.png"}"#.to_string());
+            g.material(&format!(
+                r#"{{"pbrMetallicRoughness": {{"baseColorTexture": {{"index": {k}}}, "metallicFactor": 0.0}}}}"#
+            ));
+            primitive(p, Some(i), &format!(r#", "material": {k}"#))
+        })
+        .collect();
+    g.mesh(&prims);
+    g.node(r#""mesh": 0"#);
+    dir.write("images.gltf", g.gltf());
+    let s = dir.load(&scene_toml(&["images.gltf"], "")).unwrap();
+    assert_eq!(s.materials.len(), n);
+    // The files a scene read: the scene, the glTF, and the PNG once (it was read, and
+    // listed, once per image entry).
+    let pngs = s.files.iter().filter(|f| f.ends_with("t.png")).count();
+    assert_eq!(pngs, 1, "{:?}", s.files);
+}
+
+include!("common/tiny_png.rs");

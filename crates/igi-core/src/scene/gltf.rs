@@ -281,6 +281,41 @@ mod tests {
     }
 
     #[test]
+    fn each_image_source_is_decoded_once() {
+        let png: &[u8] = &PNG;
+        // 30 image entries of one buffer view, 30 of one file (named two ways), one of
+        // another view; each with its texture and material, on its own primitive.
+        let mut g = quad(None);
+        let v = g.view(png);
+        let w = g.view(png);
+        for k in 0..61 {
+            g.images.push(match k {
+                0..30 => format!(r#"{{"bufferView": {v}, "mimeType": "image/png"}}"#),
+                30..45 => r#"{"uri": "t.png"}"#.to_string(),
+                45..60 => r#"{"uri": "./t.png"}"#.to_string(),
+                _ => format!(r#"{{"bufferView": {w}, "mimeType": "image/png"}}"#),
+            });
+            g.material(&format!(
+                r#"{{"pbrMetallicRoughness": {{"baseColorTexture": {{"index": {k}}}, "metallicFactor": 0.0}}}}"#
+            ));
+        }
+        let prims: Vec<String> = (0..61)
+            .map(|k| builder::primitive(0, Some(1), &format!(r#", "material": {k}"#)))
+            .collect();
+        g.meshes[0] = format!(r#"{{"primitives": [{}]}}"#, prims.join(", "));
+        g.node(r#""mesh": 0"#);
+        let (mesh, stats) = load_counting(&g, &[("t.png", png)]);
+        assert_eq!(mesh.materials.len(), 61);
+        assert_eq!(stats.images_decoded, 3, "one view, one file, another view");
+        let first = mesh.materials[0].diffuse;
+        assert!(mesh.materials.iter().all(|m| m.diffuse == first));
+        assert_eq!(mesh.files.len(), 1, "{:?}", mesh.files);
+    }
+
+    // PNG: a 1x1 PNG.
+    include!("../../tests/common/tiny_png.rs");
+
+    #[test]
     fn gltf_paths() {
         assert!(is_gltf_path(Path::new("a/b.GLTF")));
         assert!(is_gltf_path(Path::new("b.glb")));

@@ -10,6 +10,7 @@ use ::gltf::accessor::{DataType, Dimensions, Iter};
 use glam::Vec3;
 
 use super::document::{percent_decode, Warnings};
+use super::materials::ImageSource;
 use super::messages::{parse, quote, quote_message};
 use super::nodes::Prepared;
 use super::{GltfMesh, MAX_VIEWLESS_ELEMENTS};
@@ -38,7 +39,7 @@ pub(super) struct Reader {
 }
 
 /// What many nodes or primitives may share, read once: accessors by index, primitives by
-/// (mesh, primitive) index. A file whose thousand nodes place
+/// (mesh, primitive) index, image averages by source. A file whose thousand nodes place
 /// one mesh reads its data once, and only its triangles are made per node.
 #[derive(Default)]
 pub(super) struct Shared {
@@ -46,6 +47,7 @@ pub(super) struct Shared {
     pub(super) indices: HashMap<usize, Rc<[u32]>>,
     /// `None`: a primitive of mode POINTS or LINES*, skipped.
     pub(super) primitives: HashMap<(usize, usize), Option<Rc<Prepared>>>,
+    pub(super) images: HashMap<ImageSource, Option<Vec3>>,
     /// Elements of accessors without a buffer view read so far (see
     /// [`MAX_VIEWLESS_ELEMENTS`]).
     pub(super) viewless: usize,
@@ -56,6 +58,7 @@ pub(super) struct Shared {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub(super) struct ReadStats {
     pub(super) accessors_read: usize,
+    pub(super) images_decoded: usize,
 }
 
 impl Reader {
