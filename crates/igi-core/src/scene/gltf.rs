@@ -27,6 +27,12 @@
 //! header and the POSITION indices (which gltf's validation indexes with `[]`) are checked
 //! before the crate sees them, and the whole read runs under `catch_unwind` as a last
 //! resort.
+//!
+//! Work follows the file's size: the node tree is walked and the triangles it would make
+//! are counted (against the scene's [`MAX_TRIANGLES`](super::loader::MAX_TRIANGLES))
+//! before any accessor is read; accessors, primitives and images are read once however
+//! many nodes, primitives or materials use them; accessors without a buffer view are
+//! bounded by [`MAX_VIEWLESS_ELEMENTS`].
 
 mod accessors;
 mod document;

@@ -4,7 +4,10 @@
 //! Every failure is a [`SceneError`] whose message is one line that names the file (and the
 //! line, and for TOML the column, where known), e.g.
 //! `scenes/box/box.obj:123: face index 999 out of range (the file has 456 vertices)`.
-//! Nothing in here panics on user data.
+//! Nothing in here panics on user data. Text quoted from a file is shortened (the `quote`
+//! helpers of `error`), so a huge name makes a short message. Work and memory follow the
+//! files' sizes: a scene has at most [`MAX_TRIANGLES`] triangles, each mesh counted before
+//! it is read.
 //!
 //! Choices where the contract leaves room (they follow the reference converter
 //! `shared/tools/scene_to_mitsuba.py`, so that a scene means the same thing to both):
@@ -36,7 +39,8 @@
 //!   otherwise). In OBJ and MTL files a `#` that starts a word starts a comment, on every
 //!   kind of line (`strip_comments`).
 //! - A TOML file must be UTF-8. In OBJ and MTL files a NUL byte is an error (binary data),
-//!   other bytes that are not UTF-8 (a Latin-1 comment) are replaced, with a warning.
+//!   other bytes that are not UTF-8 (a Latin-1 comment) are replaced, with a warning, and
+//!   a lone CR ends a line as LF and CRLF do.
 //!
 //! OBJ files are read with `tobj` (`load_obj_buf`, fanning polygons, separate
 //! position/normal indices, points and lines ignored), preceded by our own fast pass over
