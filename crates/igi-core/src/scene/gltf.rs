@@ -217,14 +217,17 @@ mod tests {
     use super::test_builder as builder;
     use builder::{quad, Gltf, QUAD_INDICES};
 
-    /// Loads `g` (as `name` in a temp dir holding `files`), with what reading took.
+    /// Loads `g` (as `t.gltf` in a temp dir holding `files`), with what reading took.
     fn load_counting(g: &Gltf, files: &[(&str, &[u8])]) -> (GltfMesh, ReadStats) {
-        let dir = std::env::temp_dir().join(format!("igi-gltf-unit-{}", std::process::id()));
+        static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+        let n = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        let dir = std::env::temp_dir().join(format!("igi-gltf-unit-{}-{n}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         for (name, bytes) in files {
             std::fs::write(dir.join(name), bytes).unwrap();
         }
         let r = load_counted(&g.gltf(), &dir.join("t.gltf"), TriangleBudget::default());
+        let _ = std::fs::remove_dir_all(&dir);
         r.unwrap_or_else(|e| panic!("{e}"))
     }
 
