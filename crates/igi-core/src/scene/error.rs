@@ -64,7 +64,7 @@ impl std::fmt::Display for Location {
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
     /// A file could not be read: missing, unreadable, a directory.
-    #[error("cannot read {what} '{}'{}: {}", one_line(&.path.display().to_string()), context_suffix(.context), io_message(.error))]
+    #[error("cannot read {what} '{}'{}: {}", quote_path(&.path.display().to_string()), context_suffix(.context), io_message(.error))]
     Read {
         /// "scene file", "mesh" or "material library".
         what: &'static str,
@@ -136,14 +136,63 @@ pub(super) fn one_line(s: &str) -> String {
         .collect()
 }
 
-/// A line of a file, shortened for a message.
-pub(super) fn excerpt(line: &str) -> String {
-    const MAX: usize = 60;
-    let line = line.trim();
-    match line.char_indices().nth(MAX) {
-        Some((i, _)) => format!("{}...", one_line(&line[..i])),
-        None => one_line(line),
+/// The most characters of a name, word or value from a file that a message quotes whole.
+pub const QUOTED_CHARS: usize = 80;
+
+/// The most characters of a path from a file (a mesh, a material library, a buffer) that a
+/// message quotes whole: more than a real path needs, so that only hostile text is cut.
+pub const QUOTED_PATH_CHARS: usize = 300;
+
+/// How many characters of a line of a file [`excerpt`] keeps.
+const EXCERPT_CHARS: usize = 60;
+
+/// Text from a file as a message quotes it: on one line, and past `max` characters cut
+/// to its first `max`, an ellipsis and, when `note_length`, its full length, so that a
+/// 150 KB material name makes a readable message (`nnnn... (150000 characters)`), not a
+/// 300,000-character line. Every loader message that quotes a file goes through here.
+fn shorten(text: &str, max: usize, note_length: bool) -> String {
+    match text.char_indices().nth(max) {
+        Some((i, _)) if note_length => format!(
+            "{}... ({} characters)",
+            one_line(&text[..i]),
+            text.chars().count()
+        ),
+        Some((i, _)) => format!("{}...", one_line(&text[..i])),
+        None => one_line(text),
     }
+}
+
+/// A name, word or value from a file (a material name, a face index, a URI), for a
+/// message: at most [`QUOTED_CHARS`] characters, with the full length when cut.
+pub(super) fn quote(text: &str) -> String {
+    shorten(text, QUOTED_CHARS, true)
+}
+
+/// A path from a file, for a message: at most [`QUOTED_PATH_CHARS`] characters, with the
+/// full length when cut.
+pub(super) fn quote_path(path: &str) -> String {
+    shorten(path, QUOTED_PATH_CHARS, true)
+}
+
+/// Another crate's message about the file (the toml, JSON and glTF crates quote the
+/// file's keys and values between backticks or double quotes): each part between those
+/// quotes shortened as [`quote`] does.
+pub(super) fn quote_message(message: &str) -> String {
+    let mut out = String::new();
+    let mut rest = message;
+    while let Some(i) = rest.find(['`', '"']) {
+        out.push_str(&quote(&rest[..i]));
+        out.push_str(&rest[i..=i]);
+        rest = &rest[i + 1..];
+    }
+    out.push_str(&quote(rest));
+    out
+}
+
+/// A line of a file, trimmed and shortened for a message (the line is what is wrong, its
+/// length is not).
+pub(super) fn excerpt(line: &str) -> String {
+    shorten(line.trim(), EXCERPT_CHARS, false)
 }
 
 pub(super) fn fmt3(v: [f32; 3]) -> String {
@@ -181,8 +230,33 @@ pub(super) fn as_text<'a>(bytes: &'a [u8], file: &str) -> Result<&'a str, SceneE
 
 /// An OBJ or MTL file as text. A NUL byte means binary data: an error. Other bytes that
 /// are not UTF-8 (a Latin-1 comment or material name, say) are replaced by U+FFFD with a
-/// warning, as the reference converter reads these files (`errors="replace"`).
+/// warning, as the reference converter reads these files (`errors="replace"`). Lines may
+/// end in LF, CRLF or a lone CR (classic Mac OS files): a lone CR becomes an LF, because
+/// tobj and our own passes split lines at LF only, and such a file was one long line
+/// without a face.
 pub(super) fn as_lenient_text<'a>(bytes: &'a [u8], file: &str) -> Result<Cow<'a, str>, SceneError> {
+    match lone_cr_as_lf(bytes) {
+        None => lenient_text(bytes, file),
+        Some(fixed) => lenient_text(&fixed, file).map(|t| Cow::Owned(t.into_owned())),
+    }
+}
+
+/// `bytes` with every CR that is not followed by an LF turned into an LF, or `None` when
+/// there is none. One byte for one, so offsets (and line numbers) stay those of the file.
+fn lone_cr_as_lf(bytes: &[u8]) -> Option<Vec<u8>> {
+    let lone = |i: usize| bytes[i] == b'\r' && bytes.get(i + 1) != Some(&b'\n');
+    // `contains` is a fast byte search; most files have no CR or only CRLFs.
+    if !bytes.contains(&b'\r') || !(0..bytes.len()).any(lone) {
+        return None;
+    }
+    Some(
+        (0..bytes.len())
+            .map(|i| if lone(i) { b'\n' } else { bytes[i] })
+            .collect(),
+    )
+}
+
+fn lenient_text<'a>(bytes: &'a [u8], file: &str) -> Result<Cow<'a, str>, SceneError> {
     // `contains` searches bytes with memchr, many at a time, several times faster than a
     // byte loop over a large mesh; the offset is only wanted for the error.
     if bytes.contains(&0) {
@@ -242,5 +316,29 @@ mod tests {
         assert_eq!(excerpt(&"x".repeat(100)).len(), 63);
         let e = SceneError::invalid(Location::file("f\ng"), "two\nlines");
         assert_eq!(e.to_string(), "f g: two lines");
+    }
+
+    #[test]
+    fn long_quoted_text_is_cut_with_its_length() {
+        assert_eq!(quote("short\nname"), "short name");
+        let long = "é".repeat(QUOTED_CHARS + 1);
+        let q = quote(&long);
+        assert!(q.starts_with(&"é".repeat(QUOTED_CHARS)), "{q}");
+        assert!(
+            q.ends_with(&format!("... ({} characters)", QUOTED_CHARS + 1)),
+            "{q}"
+        );
+        assert_eq!(quote(&"x".repeat(QUOTED_CHARS)), "x".repeat(QUOTED_CHARS));
+        // Each part of another crate's message between quotes is cut on its own.
+        let key = "k".repeat(1000);
+        let m = quote_message(&format!("unknown field `{key}`, expected `eye` or \"up\""));
+        assert_eq!(
+            m,
+            format!(
+                "unknown field `{}... (1000 characters)`, expected `eye` or \"up\"",
+                "k".repeat(QUOTED_CHARS)
+            )
+        );
+        assert!(quote_path(&"p".repeat(5000)).chars().count() < QUOTED_PATH_CHARS + 30);
     }
 }

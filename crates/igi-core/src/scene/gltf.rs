@@ -27,6 +27,12 @@
 //! header and the POSITION indices (which gltf's validation indexes with `[]`) are checked
 //! before the crate sees them, and the whole read runs under `catch_unwind` as a last
 //! resort.
+//!
+//! Work follows the file's size: the node tree is walked and the triangles it would make
+//! are counted (against the scene's [`MAX_TRIANGLES`](super::loader::MAX_TRIANGLES))
+//! before any accessor is read; accessors, primitives and images are read once however
+//! many nodes, primitives or materials use them; accessors without a buffer view are
+//! bounded by [`MAX_VIEWLESS_ELEMENTS`].
 
 mod accessors;
 mod document;
@@ -39,8 +45,9 @@ use std::path::{Path, PathBuf};
 
 use glam::Vec3;
 
-use super::loader::SceneError;
+use super::loader::{SceneError, TriangleBudget};
 use super::{PointLight, Triangle};
+use accessors::ReadStats;
 use document::read;
 use messages::parse;
 
@@ -56,9 +63,18 @@ pub const MIRROR_MAX_ROUGHNESS: f32 = 0.2;
 /// metallic 1, roughness 1, hence diffuse 1 and no mirror).
 pub const DEFAULT_MATERIAL: &str = "gltf:default";
 
-/// Vertices an accessor without a buffer view (sparse values over zeros) may declare: such
-/// a count is not bounded by any buffer's size, and reading it allocates that many items.
-const MAX_VIEWLESS_COUNT: usize = 1 << 26;
+/// How far from 1 the length of a node's rotation quaternion may be: further is an error,
+/// closer is normalised. The value is the Khronos glTF-Validator's (`ROTATION_NON_UNIT`,
+/// an error there too), slightly more than the error of quaternions quantised to signed
+/// 8 bits; float rotations written with 6 or more digits are within 1e-5 of unit length,
+/// and even 3 decimals stay within 1e-3, so only a rotation that is not one is refused.
+pub const MAX_ROTATION_LENGTH_ERROR: f32 = 0.00769;
+
+/// Elements that the accessors without a buffer view (zeros, or sparse values over zeros)
+/// of one file may declare in all (1,048,576: 12 MiB as positions). Such a count is paid
+/// for by no bytes of the file, so a 1.5 KB file could ask for gigabytes; real files use
+/// them for small sparse edits (mostly of morph targets, which are not read).
+pub const MAX_VIEWLESS_ELEMENTS: usize = 1 << 20;
 
 /// How many validation problems a message lists before "(and N more)".
 const MAX_LISTED: usize = 3;
@@ -123,11 +139,30 @@ pub fn load_gltf(path: &Path) -> Result<GltfMesh, SceneError> {
 
 /// Reads a glTF file (JSON or GLB, told apart by the GLB magic, whatever the extension)
 /// whose content is `bytes`; `path` names it in messages and locates its external buffers
-/// and images (relative to its directory).
+/// and images (relative to its directory). Its node tree may make at most
+/// [`MAX_TRIANGLES`](crate::scene::loader::MAX_TRIANGLES) triangles.
 pub fn load_gltf_bytes(bytes: &[u8], path: &Path) -> Result<GltfMesh, SceneError> {
+    load_gltf_within(bytes, path, TriangleBudget::default())
+}
+
+/// [`load_gltf_bytes`] for a scene whose earlier meshes used part of `budget`.
+pub(super) fn load_gltf_within(
+    bytes: &[u8],
+    path: &Path,
+    budget: TriangleBudget,
+) -> Result<GltfMesh, SceneError> {
+    load_counted(bytes, path, budget).map(|(mesh, _)| mesh)
+}
+
+/// [`load_gltf_within`], with what reading took.
+fn load_counted(
+    bytes: &[u8],
+    path: &Path,
+    budget: TriangleBudget,
+) -> Result<(GltfMesh, ReadStats), SceneError> {
     let file = path.display().to_string();
     // A last resort: every known panic of the gltf crate is prevented by checks below.
-    match catch_unwind(AssertUnwindSafe(|| read(bytes, path, &file))) {
+    match catch_unwind(AssertUnwindSafe(|| read(bytes, path, &file, budget))) {
         Ok(result) => result,
         Err(_) => Err(parse(
             &file,
@@ -135,6 +170,11 @@ pub fn load_gltf_bytes(bytes: &[u8], path: &Path) -> Result<GltfMesh, SceneError
         )),
     }
 }
+
+/// The glTF builder of the integration tests, for the tests below.
+#[cfg(test)]
+#[path = "../../tests/common/gltf_builder.rs"]
+mod test_builder;
 
 #[cfg(test)]
 mod tests {
@@ -173,6 +213,116 @@ mod tests {
         assert!((srgb_to_linear(1.0) - 1.0).abs() < 1e-6);
         assert!((srgb_to_linear(0.5) - 0.214_041).abs() < 1e-5);
     }
+
+    use super::test_builder as builder;
+    use builder::{quad, Gltf, QUAD_INDICES};
+
+    /// Loads `g` (as `t.gltf` in a temp dir holding `files`), with what reading took.
+    fn load_counting(g: &Gltf, files: &[(&str, &[u8])]) -> (GltfMesh, ReadStats) {
+        static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+        let n = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        let dir = std::env::temp_dir().join(format!("igi-gltf-unit-{}-{n}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        for (name, bytes) in files {
+            std::fs::write(dir.join(name), bytes).unwrap();
+        }
+        let r = load_counted(&g.gltf(), &dir.join("t.gltf"), TriangleBudget::default());
+        let _ = std::fs::remove_dir_all(&dir);
+        r.unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    #[test]
+    fn accessors_shared_by_nodes_and_primitives_are_read_once() {
+        // The quad with normals, placed by 40 nodes; a second mesh whose two primitives
+        // share the quad's POSITION and indices.
+        let mut g = quad(None);
+        let n = g.normals(&[[0.0, 0.0, 1.0]; 4]);
+        g.meshes[0] = g.meshes[0].replace(
+            r#""POSITION": 0"#,
+            &format!(r#""POSITION": 0, "NORMAL": {n}"#),
+        );
+        g.mesh(&[
+            builder::primitive(0, Some(1), ""),
+            builder::primitive(0, Some(1), r#", "mode": 4"#),
+        ]);
+        let nodes = 40;
+        for k in 0..nodes {
+            g.node(&format!(r#""mesh": 0, "translation": [{k}.0, 0.0, 0.0]"#));
+        }
+        g.node(r#""mesh": 1"#);
+        g.roots = (0..=nodes).collect();
+        let (mesh, stats) = load_counting(&g, &[]);
+        assert_eq!(mesh.triangles.len(), 2 * (nodes + 2));
+        assert_eq!(
+            stats.accessors_read, 3,
+            "POSITION, NORMAL and indices, once each"
+        );
+        // Each node's copy is where its node puts it.
+        for k in 0..nodes {
+            assert_eq!(
+                mesh.triangles[2 * k].v[1],
+                Vec3::new(k as f32 + 1.0, 0.0, 0.0)
+            );
+        }
+
+        // A sparse accessor without a buffer view used by many nodes: read once too.
+        let mut g = Gltf::default();
+        let idx: Vec<u8> = [1u16, 2, 3].iter().flat_map(|x| x.to_le_bytes()).collect();
+        let vals: Vec<u8> = [[1.0f32, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]]
+            .iter()
+            .flatten()
+            .flat_map(|x| x.to_le_bytes())
+            .collect();
+        let (iv, vv) = (g.view(&idx), g.view(&vals));
+        let count = MAX_VIEWLESS_ELEMENTS / 2;
+        let p = g.accessor(format!(
+            r#"{{"componentType": 5126, "count": {count}, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0], "sparse": {{"count": 3, "indices": {{"bufferView": {iv}, "componentType": 5123}}, "values": {{"bufferView": {vv}}}}}}}"#
+        ));
+        let i = g.indices(&QUAD_INDICES);
+        g.mesh(&[builder::primitive(p, Some(i), "")]);
+        for _ in 0..nodes {
+            g.node(r#""mesh": 0"#);
+        }
+        g.roots = (0..nodes).collect();
+        let (mesh, stats) = load_counting(&g, &[]);
+        assert_eq!(mesh.triangles.len(), 2 * nodes);
+        assert_eq!(stats.accessors_read, 2);
+    }
+
+    #[test]
+    fn each_image_source_is_decoded_once() {
+        let png: &[u8] = &PNG;
+        // 30 image entries of one buffer view, 30 of one file (named two ways), one of
+        // another view; each with its texture and material, on its own primitive.
+        let mut g = quad(None);
+        let v = g.view(png);
+        let w = g.view(png);
+        for k in 0..61 {
+            g.images.push(match k {
+                0..30 => format!(r#"{{"bufferView": {v}, "mimeType": "image/png"}}"#),
+                30..45 => r#"{"uri": "t.png"}"#.to_string(),
+                45..60 => r#"{"uri": "./t.png"}"#.to_string(),
+                _ => format!(r#"{{"bufferView": {w}, "mimeType": "image/png"}}"#),
+            });
+            g.material(&format!(
+                r#"{{"pbrMetallicRoughness": {{"baseColorTexture": {{"index": {k}}}, "metallicFactor": 0.0}}}}"#
+            ));
+        }
+        let prims: Vec<String> = (0..61)
+            .map(|k| builder::primitive(0, Some(1), &format!(r#", "material": {k}"#)))
+            .collect();
+        g.meshes[0] = format!(r#"{{"primitives": [{}]}}"#, prims.join(", "));
+        g.node(r#""mesh": 0"#);
+        let (mesh, stats) = load_counting(&g, &[("t.png", png)]);
+        assert_eq!(mesh.materials.len(), 61);
+        assert_eq!(stats.images_decoded, 3, "one view, one file, another view");
+        let first = mesh.materials[0].diffuse;
+        assert!(mesh.materials.iter().all(|m| m.diffuse == first));
+        assert_eq!(mesh.files.len(), 1, "{:?}", mesh.files);
+    }
+
+    // PNG: a 1x1 PNG.
+    include!("../../tests/common/tiny_png.rs");
 
     #[test]
     fn gltf_paths() {

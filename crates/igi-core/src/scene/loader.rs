@@ -4,7 +4,10 @@
 //! Every failure is a [`SceneError`] whose message is one line that names the file (and the
 //! line, and for TOML the column, where known), e.g.
 //! `scenes/box/box.obj:123: face index 999 out of range (the file has 456 vertices)`.
-//! Nothing in here panics on user data.
+//! Nothing in here panics on user data. Text quoted from a file is shortened (the `quote`
+//! helpers of `error`), so a huge name makes a short message. Work and memory follow the
+//! files' sizes: a scene has at most [`MAX_TRIANGLES`] triangles, each mesh counted before
+//! it is read.
 //!
 //! Choices where the contract leaves room (they follow the reference converter
 //! `shared/tools/scene_to_mitsuba.py`, so that a scene means the same thing to both):
@@ -36,7 +39,8 @@
 //!   otherwise). In OBJ and MTL files a `#` that starts a word starts a comment, on every
 //!   kind of line (`strip_comments`).
 //! - A TOML file must be UTF-8. In OBJ and MTL files a NUL byte is an error (binary data),
-//!   other bytes that are not UTF-8 (a Latin-1 comment) are replaced, with a warning.
+//!   other bytes that are not UTF-8 (a Latin-1 comment) are replaced, with a warning, and
+//!   a lone CR ends a line as LF and CRLF do.
 //!
 //! OBJ files are read with `tobj` (`load_obj_buf`, fanning polygons, separate
 //! position/normal indices, points and lines ignored), preceded by our own fast pass over
@@ -69,7 +73,7 @@ use glam::Vec3;
 use serde::Deserialize;
 use toml::Spanned;
 
-use super::error::as_text;
+use super::error::{as_text, quote};
 use super::mtl::{resolve_material, undefined_material, MtlDef, MtlTable};
 use super::obj::{load_obj, Slot};
 use super::toml_file::{
@@ -80,6 +84,58 @@ use super::{Camera, Material, Scene, Triangle};
 
 pub use super::error::{without_os_error_code, Location, SceneError};
 pub use super::toml_file::{max_light_intensity, DEFAULT_FILM, DEFAULT_UP};
+
+/// The most triangles a scene may have, over all its meshes: 16,777,216 (2^24), fifty times
+/// the conference room's 331K. A loaded triangle takes 76 bytes, and the BVH build and the
+/// GPU's copy take several times that again, so the limit keeps a scene within a few GB of
+/// memory; without it a small file whose node tree places one mesh many times (or a scene
+/// file naming one mesh many times) asked for billions of triangles and aborted on a
+/// failed allocation. Meshes are counted before they are read.
+pub const MAX_TRIANGLES: usize = 1 << 24;
+
+/// The triangles a scene may still take while its meshes are read: `limit` in all, of
+/// which the meshes read so far have `used`.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct TriangleBudget {
+    pub(super) limit: usize,
+    pub(super) used: usize,
+}
+
+impl Default for TriangleBudget {
+    fn default() -> Self {
+        TriangleBudget {
+            limit: MAX_TRIANGLES,
+            used: 0,
+        }
+    }
+}
+
+impl TriangleBudget {
+    /// Checks that `more` triangles, counted before they are made, fit; otherwise an error
+    /// naming `file`, what `made` says ("its faces make 123 triangles") and the limit.
+    pub(super) fn check(
+        &self,
+        more: usize,
+        file: &str,
+        made: impl FnOnce() -> String,
+    ) -> Result<(), SceneError> {
+        if more <= self.limit.saturating_sub(self.used) {
+            return Ok(());
+        }
+        let earlier = match self.used {
+            0 => String::new(),
+            n => format!(", and the scene's earlier meshes {n}"),
+        };
+        Err(SceneError::invalid(
+            Location::file(file),
+            format!(
+                "{}{earlier}: more than the {} triangles a scene may have",
+                made(),
+                self.limit
+            ),
+        ))
+    }
+}
 
 /// Coordinates beyond which ray tests may overflow (2^62, ~4.6e18; an edge of 9e18 was
 /// already missed on lavapipe).
@@ -167,6 +223,16 @@ pub fn camera_toml(camera: &Camera) -> String {
 /// `name` stands for the TOML file in messages and becomes [`Scene::source`].
 /// [`Scene::files`] lists the meshes and material libraries read.
 pub fn load_scene_str(toml_text: &str, base_dir: &Path, name: &str) -> Result<Scene, SceneError> {
+    load_scene_str_within(toml_text, base_dir, name, MAX_TRIANGLES)
+}
+
+/// [`load_scene_str`] with a scene of at most `max_triangles` triangles.
+pub(super) fn load_scene_str_within(
+    toml_text: &str,
+    base_dir: &Path,
+    name: &str,
+    max_triangles: usize,
+) -> Result<Scene, SceneError> {
     let tf = TomlFile {
         text: toml_text,
         name,
@@ -214,9 +280,13 @@ pub fn load_scene_str(toml_text: &str, base_dir: &Path, name: &str) -> Result<Sc
         })?;
         files.push(obj_path.clone());
         let first_slot = slots.len();
+        let budget = TriangleBudget {
+            limit: max_triangles,
+            used: triangles.len(),
+        };
         // glTF hook: `.gltf`/`.glb` meshes are read by scene/gltf.rs (see add_gltf).
         if super::gltf::is_gltf_path(&obj_path) {
-            let g = super::gltf::load_gltf_bytes(&bytes, &obj_path)?;
+            let g = super::gltf::load_gltf_within(&bytes, &obj_path, budget)?;
             lights.extend_from_slice(&g.lights);
             files.extend_from_slice(&g.files);
             let has_default = mesh.default_material.is_some();
@@ -235,6 +305,7 @@ pub fn load_scene_str(toml_text: &str, base_dir: &Path, name: &str) -> Result<Sc
             &bytes,
             &obj_path,
             mesh_index,
+            budget,
             &mut slots,
             &mut triangles,
             &mut mtl,
@@ -275,7 +346,7 @@ pub fn load_scene_str(toml_text: &str, base_dir: &Path, name: &str) -> Result<Sc
                 Some(d) => (
                     d.get_ref().as_str(),
                     tf.at(d.span()),
-                    format!("default_material of mesh '{}'", mesh.path.get_ref()),
+                    format!("default_material of mesh '{}'", quote(mesh.path.get_ref())),
                 ),
                 None => {
                     return Err(SceneError::invalid(
@@ -311,7 +382,10 @@ pub fn load_scene_str(toml_text: &str, base_dir: &Path, name: &str) -> Result<Sc
     for mat_name in desc.materials.keys() {
         if !by_name.contains_key(mat_name) {
             resolve_material(&tf, mat_name, &desc.materials, &mtl)?;
-            log::warn!("{name}: [materials.{mat_name}] is used by no face; ignored");
+            log::warn!(
+                "{name}: [materials.{}] is used by no face; ignored",
+                quote(mat_name)
+            );
         }
     }
     if triangles.is_empty() {
@@ -377,7 +451,7 @@ fn add_gltf(
                 Some(old) if old.diffuse() != def.diffuse() || old.mirror() != def.mirror() => {
                     log::warn!(
                         "{file}: material '{}' is also defined in {} with other values; the first definition is used",
-                        m.name,
+                        quote(&m.name),
                         old.at
                     );
                 }
@@ -402,4 +476,76 @@ fn add_gltf(
         t.material += slot_base as u32;
         t
     }));
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The triangle limit counts each mesh, OBJ or glTF, before reading it, with the
+    /// triangles of the meshes before it (a small limit stands for [`MAX_TRIANGLES`]).
+    #[test]
+    fn the_triangle_limit_counts_every_mesh_before_it_is_read() {
+        let dir = std::env::temp_dir().join(format!("igi-loader-limit-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let ring: String = (0..7)
+            .map(|k| {
+                let a = k as f32;
+                format!("v {} {} 0\n", a.cos(), a.sin())
+            })
+            .collect();
+        std::fs::write(dir.join("quad.obj"), format!("{ring}f 1 2 3 4\n")).unwrap();
+        std::fs::write(dir.join("fan.obj"), format!("{ring}f 1 2 3 4 5 6 7\n")).unwrap();
+        // One triangle (positions and indices in a data: URI).
+        let gltf = r#"{"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],"meshes":[{"primitives":[{"attributes":{"POSITION":0},"indices":1}]}],"buffers":[{"byteLength":42,"uri":"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAAAAABAAIA"}],"bufferViews":[{"buffer":0,"byteOffset":0,"byteLength":36},{"buffer":0,"byteOffset":36,"byteLength":6}],"accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]},{"bufferView":1,"componentType":5123,"count":3,"type":"SCALAR"}]}"#;
+        std::fs::write(dir.join("tri.gltf"), gltf).unwrap();
+        let scene = |meshes: &[&str]| {
+            let meshes: String = meshes
+                .iter()
+                .map(|m| format!("[[mesh]]\npath = \"{m}\"\ndefault_material = \"d\"\n"))
+                .collect();
+            format!("[camera]\neye = [0.0, 0.0, 5.0]\ntarget = [0.0, 0.0, 0.0]\nfov_y_deg = 40.0\n[[point_light]]\nposition = [0.0, 0.0, 3.0]\nintensity = [1.0, 1.0, 1.0]\n[materials.d]\ndiffuse = [0.5, 0.5, 0.5]\n{meshes}")
+        };
+        let load =
+            |meshes: &[&str], limit| load_scene_str_within(&scene(meshes), &dir, "s.toml", limit);
+        let message = |r: Result<Scene, SceneError>| r.err().map(|e| e.to_string()).unwrap();
+
+        let three = ["quad.obj", "quad.obj", "fan.obj"];
+        assert_eq!(load(&three, 9).unwrap().triangles.len(), 9);
+        let e = message(load(&three, 8));
+        assert!(e.contains("fan.obj"), "{e}");
+        assert!(
+            e.ends_with("its faces make 5 triangles, and the scene's earlier meshes 4: more than the 8 triangles a scene may have"),
+            "{e}"
+        );
+        // A single mesh beyond the limit, with nothing before it.
+        let e = message(load(&["fan.obj"], 4));
+        assert!(
+            e.ends_with(
+                "fan.obj: its faces make 5 triangles: more than the 4 triangles a scene may have"
+            ),
+            "{e}"
+        );
+        // glTF after OBJ, and OBJ after glTF.
+        let e = message(load(&["quad.obj", "quad.obj", "tri.gltf"], 4));
+        assert!(
+            e.contains(
+                "tri.gltf: its node tree would make 1 triangles, and the scene's earlier meshes 4"
+            ),
+            "{e}"
+        );
+        let e = message(load(&["tri.gltf", "tri.gltf", "quad.obj"], 3));
+        assert!(
+            e.contains("quad.obj: its faces make 2 triangles, and the scene's earlier meshes 2"),
+            "{e}"
+        );
+        assert_eq!(
+            load(&["tri.gltf", "tri.gltf", "tri.gltf"], 3)
+                .unwrap()
+                .triangles
+                .len(),
+            3
+        );
+        let _ = std::fs::remove_dir_all(&dir);
+    }
 }

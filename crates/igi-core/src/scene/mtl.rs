@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use glam::Vec3;
 use toml::Spanned;
 
-use super::error::{as_lenient_text, excerpt, fmt3, Location, SceneError, CHANNELS};
+use super::error::{as_lenient_text, excerpt, fmt3, quote, Location, SceneError, CHANNELS};
 use super::obj::{strip_comments, Slot};
 use super::toml_file::{MaterialDesc, TomlFile, V3};
 use super::Material;
@@ -71,6 +71,9 @@ pub(super) fn resolve_material(
     if over.is_none() && base.is_none() {
         return Ok(None);
     }
+    // Messages quote the name shortened; the material keeps it whole.
+    let full_name = name;
+    let name = &quote(full_name);
     let pick = |key: &str, toml_v: Option<&V3>, mtl_v: Option<([f32; 3], String)>| {
         if let Some(v) = toml_v {
             Sourced {
@@ -167,7 +170,7 @@ pub(super) fn resolve_material(
         }
     }
     Ok(Some(Material {
-        name: name.to_string(),
+        name: full_name.to_string(),
         diffuse: Vec3::from(diffuse.value),
         mirror: Vec3::from(mirror.value),
     }))
@@ -180,6 +183,7 @@ pub(super) fn undefined_material(
     at: Location,
     slot: &Slot,
 ) -> SceneError {
+    let name = quote(name);
     let libs = if slot.missing_mtl.is_empty() {
         if slot.has_mtllib {
             String::new()
@@ -244,7 +248,7 @@ pub(super) fn read_mtl(bytes: &[u8], path: &Path, table: &mut MtlTable) -> Resul
                     log::warn!(
                         "{}: material '{}' is also defined in {} with other values; the first definition is used",
                         def.at,
-                        m.name,
+                        quote(&m.name),
                         old.at
                     );
                 }

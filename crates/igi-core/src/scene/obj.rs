@@ -10,8 +10,8 @@ use std::path::{Path, PathBuf};
 
 use glam::Vec3;
 
-use super::error::{as_lenient_text, excerpt, io_message, Location, SceneError};
-use super::loader::read_regular_file;
+use super::error::{as_lenient_text, excerpt, io_message, quote, quote_path, Location, SceneError};
+use super::loader::{read_regular_file, TriangleBudget};
 use super::mtl::{read_mtl, MtlTable};
 use super::Triangle;
 
@@ -215,7 +215,7 @@ pub(super) fn scan_face<'a>(
             if k >= 3 {
                 return Err(format!(
                     "face corner '{}' has more than three indices (v/vt/vn)",
-                    excerpt(corner)
+                    quote(corner)
                 ));
             }
             if part.is_empty() {
@@ -223,12 +223,12 @@ pub(super) fn scan_face<'a>(
             }
             let Ok(x) = part.parse::<isize>() else {
                 return Err(if part == corner {
-                    format!("cannot read face index '{}'", excerpt(part))
+                    format!("cannot read face index '{}'", quote(part))
                 } else {
                     format!(
                         "cannot read face index '{}' in '{}'",
-                        excerpt(part),
-                        excerpt(corner)
+                        quote(part),
+                        quote(corner)
                     )
                 });
             };
@@ -237,7 +237,7 @@ pub(super) fn scan_face<'a>(
                 return Err(format!(
                     "{} 0 in '{}': OBJ indices start at 1 (negative ones count back from the last of the {})",
                     INDEX[k],
-                    excerpt(corner),
+                    quote(corner),
                     KIND[k]
                 ));
             }
@@ -259,7 +259,7 @@ pub(super) fn scan_face<'a>(
         if !has[0] {
             return Err(format!(
                 "face corner '{}' has no vertex index",
-                excerpt(corner)
+                quote(corner)
             ));
         }
         all_vn &= has[2];
@@ -271,11 +271,13 @@ pub(super) fn scan_face<'a>(
 pub(super) const NAMES_MTLLIB: &str = "\u{1}igi-usemtl-names";
 
 /// Reads one OBJ: appends its triangles (material = slot index) and its slots; reads its
-/// MTL files into `mtl`.
+/// MTL files into `mtl`. Its faces must fit in `budget` (counted before tobj reads them).
+#[allow(clippy::too_many_arguments)]
 pub(super) fn load_obj(
     bytes: &[u8],
     path: &Path,
     mesh: usize,
+    budget: TriangleBudget,
     slots: &mut Vec<Slot>,
     out: &mut Vec<Triangle>,
     mtl: &mut MtlTable,
@@ -286,6 +288,9 @@ pub(super) fn load_obj(
     let text = strip_comments(text.as_ref());
     let text = text.as_ref();
     let scan = scan_obj(text, &file)?;
+    budget.check(scan.flags.len(), &file, || {
+        format!("its faces make {} triangles", scan.flags.len())
+    })?;
     if scan.small_faces > 0 {
         log::warn!(
             "{file}: {} faces with fewer than 3 vertices ignored",
@@ -310,11 +315,11 @@ pub(super) fn load_obj(
             Err(e) if e.kind() == io::ErrorKind::NotFound => {
                 log::warn!(
                     "{file}:{ln}: material library '{}' not found",
-                    lib_path.display()
+                    quote_path(&lib_path.display().to_string())
                 );
                 missing_mtl.push(format!(
                     "'{}' (mtllib at {file}:{ln}): {}",
-                    lib_path.display(),
+                    quote_path(&lib_path.display().to_string()),
                     io_message(&e)
                 ));
             }

@@ -9,7 +9,7 @@ use glam::{DVec3, Vec3};
 use serde::Deserialize;
 use toml::Spanned;
 
-use super::error::{excerpt, fmt3, Location, SceneError};
+use super::error::{fmt3, quote, quote_message, Location, SceneError};
 use super::{Camera, Film, PointLight};
 
 /// Image size when the scene file has no `[film]` (or leaves a key out).
@@ -137,7 +137,7 @@ impl TomlFile<'_> {
 
     /// A value as the file writes it (its span), for messages.
     pub(super) fn written(&self, span: Range<usize>) -> String {
-        excerpt(self.text.get(span).unwrap_or(""))
+        quote(self.text.get(span).unwrap_or(""))
     }
 
     pub(super) fn finite(&self, v: &V3, key: &str) -> Result<Vec3, SceneError> {
@@ -163,10 +163,11 @@ pub(super) fn toml_message(e: &toml::de::Error) -> String {
     let keys = shown
         .lines()
         .find_map(|l| l.strip_prefix("in `").and_then(|k| k.strip_suffix('`')));
-    match keys {
-        Some(k) if !k.is_empty() => format!("{k}: {}", e.message()),
+    let message = match keys {
+        Some(k) if !k.is_empty() => format!("{}: {}", quote(k), e.message()),
         _ => e.message().to_string(),
-    }
+    };
+    quote_message(&message)
 }
 
 pub(super) fn camera(tf: &TomlFile, c: &Spanned<CameraDesc>) -> Result<Camera, SceneError> {
@@ -329,7 +330,8 @@ pub(super) fn check_toml_material(
                 return Err(tf.invalid(
                     v.span(),
                     format!(
-                        "materials.{name}.{key} = {}: each channel must be in [0, 1]",
+                        "materials.{}.{key} = {}: each channel must be in [0, 1]",
+                        quote(name),
                         fmt3(a)
                     ),
                 ));

@@ -1,16 +1,20 @@
-//! The reader's state ([`Reader`]), its buffers (GLB chunk, `data:` URIs and files) and
-//! the checks of buffer views and accessors that the gltf crate's readers assume.
+//! The reader's state ([`Reader`]), its buffers (GLB chunk, `data:` URIs and files), the
+//! checks of buffer views and accessors that the gltf crate's readers assume, and the
+//! reading of each accessor, once however many primitives use it.
 
 use std::collections::HashMap;
 use std::path::PathBuf;
+use std::rc::Rc;
 
-use ::gltf::accessor::{DataType, Dimensions};
+use ::gltf::accessor::{DataType, Dimensions, Iter};
 use glam::Vec3;
 
 use super::document::{percent_decode, Warnings};
-use super::messages::{excerpt, parse};
-use super::{GltfMesh, MAX_VIEWLESS_COUNT};
-use crate::scene::loader::{read_regular_file, SceneError};
+use super::materials::ImageSource;
+use super::messages::{parse, quote, quote_message};
+use super::nodes::Prepared;
+use super::{GltfMesh, MAX_VIEWLESS_ELEMENTS};
+use crate::scene::loader::{read_regular_file, SceneError, TriangleBudget};
 
 pub(super) struct Reader {
     pub(super) file: String,
@@ -28,6 +32,33 @@ pub(super) struct Reader {
     /// neither `uri` nor `bufferView`, or a `bufferView` without `mimeType`), with why.
     pub(super) bad_images: HashMap<usize, &'static str>,
     pub(super) warn: Warnings,
+    /// The triangles the scene may still take (the loader's limit, less earlier meshes').
+    pub(super) budget: TriangleBudget,
+    pub(super) shared: Shared,
+    pub(super) stats: ReadStats,
+}
+
+/// What many nodes or primitives may share, read once: accessors by index, primitives by
+/// (mesh, primitive) index, image averages by source. A file whose thousand nodes place
+/// one mesh reads its data once, and only its triangles are made per node.
+#[derive(Default)]
+pub(super) struct Shared {
+    pub(super) vec3s: HashMap<usize, Rc<[Vec3]>>,
+    pub(super) indices: HashMap<usize, Rc<[u32]>>,
+    /// `None`: a primitive of mode POINTS or LINES*, skipped.
+    pub(super) primitives: HashMap<(usize, usize), Option<Rc<Prepared>>>,
+    pub(super) images: HashMap<ImageSource, Option<Vec3>>,
+    /// Elements of accessors without a buffer view read so far (see
+    /// [`MAX_VIEWLESS_ELEMENTS`]).
+    pub(super) viewless: usize,
+}
+
+/// How much work reading a file took, counted so that tests can check that shared data is
+/// read once.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(super) struct ReadStats {
+    pub(super) accessors_read: usize,
+    pub(super) images_decoded: usize,
 }
 
 impl Reader {
@@ -41,12 +72,12 @@ impl Reader {
         } else if uri.contains(':') {
             Err(format!(
                 "URI '{}' has an unsupported scheme (data:, file: and relative paths are read)",
-                excerpt(uri)
+                quote(uri)
             ))
         } else {
             percent_decode(uri)
                 .map(|p| self.dir.join(p))
-                .ok_or_else(|| format!("URI '{}' is not valid percent-encoded UTF-8", excerpt(uri)))
+                .ok_or_else(|| format!("URI '{}' is not valid percent-encoded UTF-8", quote(uri)))
         }
     }
 
@@ -72,7 +103,10 @@ impl Reader {
                         .map_err(|e| {
                             parse(
                                 &self.file,
-                                format!("buffer {i}: cannot decode its data: URI: {e}"),
+                                format!(
+                                    "buffer {i}: cannot decode its data: URI: {}",
+                                    quote_message(&e.to_string())
+                                ),
                             )
                         })?
                         .0
@@ -199,11 +233,17 @@ impl Reader {
         let size = acc.size();
         match acc.view() {
             Some(view) => self.check_range(&view, acc.offset(), count, size, &label)?,
-            None if count > MAX_VIEWLESS_COUNT => {
+            None if count > MAX_VIEWLESS_ELEMENTS.saturating_sub(self.shared.viewless) => {
+                let before = match self.shared.viewless {
+                    0 => String::new(),
+                    n => format!(", {n} of them taken by the accessors read before"),
+                };
                 return Err(parse(
                     &self.file,
-                    format!("{label} has no bufferView and a count of {count} (at most {MAX_VIEWLESS_COUNT})"),
-                ))
+                    format!(
+                        "{label} has no bufferView and a count of {count}: such accessors (zeros, or sparse values over zeros) cost memory that no bytes of the file pay for, and a file may have at most {MAX_VIEWLESS_ELEMENTS} of their elements in all{before}"
+                    ),
+                ));
             }
             None => {}
         }
@@ -225,6 +265,7 @@ impl Reader {
                 indices.index_type().size(),
                 &format!("{label} sparse indices"),
             )?;
+            self.check_sparse_indices(&sparse, count, &label)?;
             let values = sparse.values();
             self.check_range(
                 &values.view(),
@@ -235,5 +276,128 @@ impl Reader {
             )?;
         }
         Ok(())
+    }
+
+    /// Checks that the sparse indices of an accessor of `count` elements are strictly
+    /// increasing and below `count`, as the glTF spec requires. The gltf crate's reader
+    /// walks them in step with the elements and applies only those it meets in order: an
+    /// index out of order or out of range silently left the rest of the values unapplied.
+    /// The indices' byte range is checked (`check_range`) before.
+    pub(super) fn check_sparse_indices(
+        &self,
+        sparse: &::gltf::accessor::sparse::Sparse,
+        count: usize,
+        label: &str,
+    ) -> Result<(), SceneError> {
+        let indices = sparse.indices();
+        let view = indices.view();
+        let size = indices.index_type().size();
+        let stride = view.stride().unwrap_or(size);
+        let data = self
+            .buffers
+            .get(view.buffer().index())
+            .map_or(&[][..], |d| &d.0[..]);
+        let start = view.offset().saturating_add(indices.offset());
+        let mut previous: Option<u32> = None;
+        for k in 0..sparse.count() {
+            let at = start.saturating_add(k.saturating_mul(stride));
+            let i = match data.get(at..at.saturating_add(size)) {
+                Some(&[x]) => u32::from(x),
+                Some(&[x, y]) => u32::from(u16::from_le_bytes([x, y])),
+                Some(&[x, y, z, w]) => u32::from_le_bytes([x, y, z, w]),
+                _ => {
+                    return Err(parse(
+                        &self.file,
+                        format!("{label} sparse indices: element {k} lies outside its buffer"),
+                    ))
+                }
+            };
+            if i as usize >= count {
+                return Err(parse(
+                    &self.file,
+                    format!(
+                        "{label} sparse indices: element {k} is {i}, out of range: the accessor has {count} elements"
+                    ),
+                ));
+            }
+            if let Some(p) = previous.filter(|&p| i <= p) {
+                return Err(parse(
+                    &self.file,
+                    format!(
+                        "{label} sparse indices: element {k} is {i}, not greater than element {} ({p}): the glTF spec requires strictly increasing indices",
+                        k - 1
+                    ),
+                ));
+            }
+            previous = Some(i);
+        }
+        Ok(())
+    }
+
+    /// The elements of a VEC3 FLOAT accessor (POSITION, NORMAL), checked and read on first
+    /// use; `what` names it in messages ("mesh 0 primitive 1 POSITION").
+    pub(super) fn vec3s(
+        &mut self,
+        acc: &::gltf::Accessor,
+        what: &str,
+    ) -> Result<Rc<[Vec3]>, SceneError> {
+        if let Some(v) = self.shared.vec3s.get(&acc.index()) {
+            return Ok(v.clone());
+        }
+        self.check_accessor(acc, what, &[DataType::F32], Dimensions::Vec3)?;
+        let buffers = &self.buffers;
+        let data = |b: ::gltf::Buffer| buffers.get(b.index()).map(|d| d.0.as_slice());
+        let values: Rc<[Vec3]> = Iter::<[f32; 3]>::new(acc.clone(), data)
+            .ok_or_else(|| self.unreadable(acc, what))?
+            .map(Vec3::from)
+            .collect();
+        self.read_once(acc);
+        self.shared.vec3s.insert(acc.index(), values.clone());
+        Ok(values)
+    }
+
+    /// The elements of a SCALAR accessor of unsigned integers (indices), as [`Self::vec3s`].
+    pub(super) fn indices(
+        &mut self,
+        acc: &::gltf::Accessor,
+        what: &str,
+    ) -> Result<Rc<[u32]>, SceneError> {
+        if let Some(v) = self.shared.indices.get(&acc.index()) {
+            return Ok(v.clone());
+        }
+        let types = [DataType::U8, DataType::U16, DataType::U32];
+        self.check_accessor(acc, what, &types, Dimensions::Scalar)?;
+        let buffers = &self.buffers;
+        let data = |b: ::gltf::Buffer| buffers.get(b.index()).map(|d| d.0.as_slice());
+        let values: Option<Rc<[u32]>> = match acc.data_type() {
+            DataType::U8 => Iter::<u8>::new(acc.clone(), data).map(|i| i.map(u32::from).collect()),
+            DataType::U16 => {
+                Iter::<u16>::new(acc.clone(), data).map(|i| i.map(u32::from).collect())
+            }
+            _ => Iter::<u32>::new(acc.clone(), data).map(|i| i.collect()),
+        };
+        let values = values.ok_or_else(|| self.unreadable(acc, what))?;
+        self.read_once(acc);
+        self.shared.indices.insert(acc.index(), values.clone());
+        Ok(values)
+    }
+
+    /// Counts a read accessor, and the elements of one without a buffer view.
+    fn read_once(&mut self, acc: &::gltf::Accessor) {
+        self.stats.accessors_read += 1;
+        if acc.view().is_none() {
+            self.shared.viewless += acc.count();
+        }
+    }
+
+    /// The gltf crate found no data for an accessor that [`Self::check_accessor`] passed.
+    fn unreadable(&self, acc: &::gltf::Accessor, what: &str) -> SceneError {
+        parse(
+            &self.file,
+            format!(
+                "{what} (accessor {}): internal error: cannot read the accessor",
+                acc.index()
+            ),
+        )
     }
 }

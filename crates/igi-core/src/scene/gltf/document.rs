@@ -1,15 +1,18 @@
 //! The glTF document: parsing the JSON or GLB (with the checks that keep the gltf crate
 //! from panicking), the whole read of one file, and the warnings reported once per file.
 
+use std::borrow::Cow;
 use std::collections::HashMap;
 use std::path::Path;
 
+use ::gltf::json::deserialize::{from_slice, from_value};
+use ::gltf::json::{Root, Value};
 use ::gltf::Semantic;
 
-use super::accessors::Reader;
+use super::accessors::{ReadStats, Reader, Shared};
 use super::messages::{document_error, invalid, parse};
 use super::GltfMesh;
-use crate::scene::loader::SceneError;
+use crate::scene::loader::{SceneError, TriangleBudget};
 
 /// Decodes `%XX` escapes of a relative URI. `None` when the result is not UTF-8 (the gltf
 /// crate would panic on such a URI, so it never sees one).
@@ -54,7 +57,7 @@ pub(super) fn document(bytes: &[u8], file: &str) -> Result<::gltf::Gltf, SceneEr
             ));
         }
     }
-    let raw = ::gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| {
+    let error = |e: ::gltf::Error| {
         let e = document_error(e, file, is_glb);
         // A `.glb` that is neither GLB nor JSON: say that the magic is missing.
         let ext_glb = file.to_ascii_lowercase().ends_with(".glb");
@@ -67,9 +70,22 @@ pub(super) fn document(bytes: &[u8], file: &str) -> Result<::gltf::Gltf, SceneEr
             },
             e => e,
         }
-    })?;
-    let ::gltf::Gltf { document, blob } = raw;
-    let root = document.into_json();
+    };
+    let (json, blob) = if is_glb {
+        let glb = ::gltf::binary::Glb::from_slice(bytes).map_err(error)?;
+        (glb.json, glb.bin.map(Cow::into_owned))
+    } else {
+        (Cow::Borrowed(bytes), None)
+    };
+    let root = match from_slice::<Root>(&json) {
+        Ok(root) => root,
+        Err(e) => match with_extras_as_objects(&json) {
+            Some(Ok(root)) => root,
+            // The file has other faults: this error is about one of them.
+            Some(Err(other)) => return Err(error(::gltf::Error::Deserialize(other))),
+            None => return Err(error(::gltf::Error::Deserialize(e))),
+        },
+    };
     // gltf 1.4's validation reads `accessors[POSITION]` with `[]`: check that index first.
     for (m, mesh) in root.meshes.iter().enumerate() {
         for (p, prim) in mesh.primitives.iter().enumerate() {
@@ -93,7 +109,46 @@ pub(super) fn document(bytes: &[u8], file: &str) -> Result<::gltf::Gltf, SceneEr
     Ok(::gltf::Gltf { document, blob })
 }
 
-pub(super) fn read(bytes: &[u8], path: &Path, file: &str) -> Result<GltfMesh, SceneError> {
+/// The document of `json` with every `extras` that is not an object replaced by an empty
+/// object, or `None` when it has no such `extras` (or is not JSON). The glTF spec lets
+/// `extras` be any JSON value, but gltf 1.4 (without its `extras` feature) reads it into
+/// an empty struct, which refuses an array, a string, a number, a boolean or null. The
+/// renderer reads no `extras`, so their values do not matter; an object's contents are
+/// application data and are left alone. Only called once the plain reading failed, so a
+/// file without such `extras` is parsed once.
+pub(super) fn with_extras_as_objects(json: &[u8]) -> Option<Result<Root, ::gltf::json::Error>> {
+    let mut value: Value = from_slice(json).ok()?;
+    let mut replaced = 0usize;
+    // An explicit stack: JSON nesting is bounded by serde_json (128 levels), but no
+    // recursion is needed.
+    let mut stack = vec![&mut value];
+    while let Some(v) = stack.pop() {
+        match v {
+            Value::Object(map) => {
+                for (key, child) in map.iter_mut() {
+                    if key != "extras" {
+                        stack.push(child);
+                    } else if !child.is_object() {
+                        *child = Value::Object(Default::default());
+                        replaced += 1;
+                    }
+                }
+            }
+            Value::Array(items) => stack.extend(items.iter_mut()),
+            _ => {}
+        }
+    }
+    (replaced > 0).then(|| from_value(value))
+}
+
+/// Reads one glTF file (see [`super::load_gltf_bytes`]) whose triangles must fit in
+/// `budget`; with what reading it took.
+pub(super) fn read(
+    bytes: &[u8],
+    path: &Path,
+    file: &str,
+    budget: TriangleBudget,
+) -> Result<(GltfMesh, ReadStats), SceneError> {
     let ::gltf::Gltf { document, blob } = document(bytes, file)?;
     let mut r = Reader {
         file: file.to_string(),
@@ -108,6 +163,9 @@ pub(super) fn read(bytes: &[u8], path: &Path, file: &str) -> Result<GltfMesh, Sc
         textures: HashMap::new(),
         bad_images: image_problems(&document),
         warn: Warnings::default(),
+        budget,
+        shared: Shared::default(),
+        stats: ReadStats::default(),
     };
     r.load_buffers(&document, blob)?;
     let Some(scene) = document
@@ -118,7 +176,7 @@ pub(super) fn read(bytes: &[u8], path: &Path, file: &str) -> Result<GltfMesh, Sc
     };
     r.scene(&document, &scene)?;
     r.warn.log(file);
-    Ok(r.out)
+    Ok((r.out, r.stats))
 }
 
 /// Images that `Image::source()` of gltf 1.4 would `unwrap()` a `None` of: it assumes a

@@ -1,14 +1,29 @@
 //! glTF materials as diffuse + mirror ([`super::pbr_to_material`]), with the average
-//! linear colour of a base colour texture, decoded once per image.
+//! linear colour of a base colour texture, decoded once per image file or buffer view
+//! (however many image entries, textures or materials name it).
 
 use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::path::PathBuf;
 
 use glam::Vec3;
 
 use super::accessors::Reader;
-use super::messages::{excerpt, fmt3, invalid, one_line};
+use super::messages::{fmt3, invalid, quote, quote_message, quote_path};
 use super::{pbr_to_material, GltfMaterial, DEFAULT_MATERIAL};
 use crate::scene::loader::SceneError;
+
+/// Where an image's bytes are: what tells two image entries of one picture apart from two
+/// pictures (with the MIME type, which chooses the decoder when given).
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+pub(super) enum ImageSource {
+    View(usize, String),
+    /// A `data:` URI, whole.
+    Data(String, Option<String>),
+    /// A file, as the URI resolves.
+    File(PathBuf, Option<String>),
+    /// An image that cannot be decoded for a reason found before decoding (its index).
+    Unreadable(usize),
+}
 
 impl Reader {
     /// The index in `out.materials` of `mat`, read on first use.
@@ -23,7 +38,7 @@ impl Reader {
             (Some(i), _) => format!("gltf:{}:{i}", self.stem),
         };
         let label = match key {
-            Some(i) => format!("material {i} ('{}')", excerpt(&name)),
+            Some(i) => format!("material {i} ('{}')", quote(&name)),
             None => format!("the default material ('{DEFAULT_MATERIAL}')"),
         };
         let pbr = doc_mat.pbr_metallic_roughness();
@@ -78,6 +93,11 @@ impl Reader {
         if let Some(&avg) = self.textures.get(&image.index()) {
             return avg;
         }
+        let source = self.image_source(image);
+        if let Some(&avg) = self.shared.images.get(&source) {
+            self.textures.insert(image.index(), avg);
+            return avg;
+        }
         let avg = match self.decode(image) {
             Ok(data) => {
                 let avg = average_linear(&data);
@@ -95,13 +115,36 @@ impl Reader {
                     "{}: {label}: cannot decode baseColorTexture image {}: {}; its factor is used alone",
                     self.file,
                     image.index(),
-                    one_line(&why)
+                    quote_message(&why)
                 );
                 None
             }
         };
         self.textures.insert(image.index(), avg);
+        self.shared.images.insert(source, avg);
         avg
+    }
+
+    /// Where `image`'s bytes are (see [`ImageSource`]).
+    fn image_source(&self, image: &::gltf::image::Image) -> ImageSource {
+        use ::gltf::image::Source;
+        if self.bad_images.contains_key(&image.index()) {
+            return ImageSource::Unreadable(image.index());
+        }
+        match image.source() {
+            Source::View { view, mime_type } => ImageSource::View(view.index(), mime_type.into()),
+            Source::Uri { uri, mime_type } => {
+                let mime = mime_type.map(str::to_string);
+                if uri.starts_with("data:") {
+                    ImageSource::Data(uri.to_string(), mime)
+                } else {
+                    match self.resolve_uri(uri) {
+                        Ok(path) => ImageSource::File(path, mime),
+                        Err(_) => ImageSource::Unreadable(image.index()),
+                    }
+                }
+            }
+        }
     }
 
     pub(super) fn decode(
@@ -125,11 +168,15 @@ impl Reader {
             Source::Uri { uri, .. } => {
                 let p = self.resolve_uri(uri)?;
                 if !p.is_file() {
-                    return Err(format!("'{}' is not a file", p.display()));
+                    return Err(format!(
+                        "'{}' is not a file",
+                        quote_path(&p.display().to_string())
+                    ));
                 }
                 file = Some(p);
             }
         }
+        self.stats.images_decoded += 1;
         let decoded = catch_unwind(AssertUnwindSafe(|| {
             ::gltf::image::Data::from_source(image.source(), Some(&self.dir), &self.buffers)
         }));

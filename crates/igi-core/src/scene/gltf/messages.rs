@@ -3,23 +3,8 @@
 //! turned into such lines.
 
 use super::MAX_LISTED;
+pub(super) use crate::scene::error::{one_line, quote, quote_message, quote_path};
 use crate::scene::loader::{Location, SceneError};
-
-/// Messages quote file contents: keep them on one line.
-pub(super) fn one_line(s: &str) -> String {
-    s.chars()
-        .map(|c| if c.is_control() { ' ' } else { c })
-        .collect()
-}
-
-/// A string of the file (a name, a URI), shortened for a message.
-pub(super) fn excerpt(s: &str) -> String {
-    const MAX: usize = 60;
-    match s.char_indices().nth(MAX) {
-        Some((i, _)) => format!("{}...", one_line(&s[..i])),
-        None => one_line(s),
-    }
-}
 
 pub(super) fn at(file: &str) -> Location {
     Location {
@@ -52,7 +37,7 @@ pub(super) fn fmt3(v: [f32; 3]) -> String {
 /// "mesh 2" or "mesh 2 ('Chair')".
 pub(super) fn mesh_label(mesh: &::gltf::Mesh) -> String {
     match mesh.name() {
-        Some(n) => format!("mesh {} ('{}')", mesh.index(), excerpt(n)),
+        Some(n) => format!("mesh {} ('{}')", mesh.index(), quote(n)),
         None => format!("mesh {}", mesh.index()),
     }
 }
@@ -62,7 +47,7 @@ pub(super) fn mesh_label(mesh: &::gltf::Mesh) -> String {
 pub(super) fn json_error(e: &::gltf::json::Error) -> (String, usize, usize) {
     let full = e.to_string();
     let tail = format!(" at line {} column {}", e.line(), e.column());
-    let message = full.strip_suffix(&tail).unwrap_or(&full).to_string();
+    let message = quote_message(full.strip_suffix(&tail).unwrap_or(&full));
     (message, e.line(), e.column())
 }
 
@@ -73,7 +58,7 @@ pub(super) fn validation_message(
     let listed: Vec<String> = problems
         .iter()
         .take(MAX_LISTED)
-        .map(|(path, e)| format!("{path}: {}", e.to_string().to_lowercase()))
+        .map(|(path, e)| quote_message(&format!("{path}: {}", e.to_string().to_lowercase())))
         .collect();
     let more = match problems.len().saturating_sub(MAX_LISTED) {
         0 => String::new(),
@@ -153,6 +138,12 @@ pub(super) fn document_error(e: ::gltf::Error, file: &str, is_glb: bool) -> Scen
             format!("not a valid GLB (binary glTF) file: {}", glb_message(&e)),
         ),
         ::gltf::Error::Validation(problems) => parse(file, validation_message(&problems)),
-        e => parse(file, format!("cannot read the glTF file: {e}")),
+        e => parse(
+            file,
+            format!(
+                "cannot read the glTF file: {}",
+                quote_message(&e.to_string())
+            ),
+        ),
     }
 }

@@ -1,26 +1,70 @@
 //! The scene's node trees under their world matrices: the KHR_lights_punctual point
-//! lights at their nodes and each mesh primitive's triangles.
+//! lights at their nodes and each mesh primitive's triangles. The tree is walked first
+//! and the triangles it would make are counted (against the scene's limit) before any
+//! is made; each primitive's data is read once, then placed at every node that uses it.
 
-use ::gltf::accessor::{DataType, Dimensions};
+use std::rc::Rc;
+
 use ::gltf::khr_lights_punctual::Kind as LightKind;
 use ::gltf::mesh::Mode;
+use ::gltf::scene::Transform;
 use ::gltf::Semantic;
-use glam::{Mat3, Mat4, Vec3};
+use glam::{DQuat, Mat3, Mat4, Quat, Vec3};
 
 use super::accessors::Reader;
 use super::messages::{fmt3, invalid, mesh_label, parse};
-use super::LUMENS_PER_WATT;
+use super::{LUMENS_PER_WATT, MAX_ROTATION_LENGTH_ERROR};
 use crate::scene::loader::SceneError;
 use crate::scene::{PointLight, Triangle};
 
+/// A primitive's data as every node that places it uses it: its vertices, its triangles
+/// (vertex indices, checked to be in range, of vertices checked to be finite) and its
+/// material (an index in `out.materials`).
+pub(super) struct Prepared {
+    positions: Rc<[Vec3]>,
+    normals: Option<Rc<[Vec3]>>,
+    corners: Vec<[u32; 3]>,
+    material: usize,
+}
+
 impl Reader {
-    /// Walks the scene's node trees depth-first, each node's world matrix the product of
-    /// the local ones from its root down.
+    /// Places the scene's node trees: lights at their nodes' world positions, and each
+    /// mesh's triangles under its node's world matrix.
     pub(super) fn scene(
         &mut self,
         doc: &::gltf::Document,
         scene: &::gltf::Scene,
     ) -> Result<(), SceneError> {
+        let placed = self.world_matrices(doc, scene)?;
+        self.check_triangle_count(doc, &placed)?;
+        for (node, world) in &placed {
+            if let Some(mesh) = node.mesh() {
+                if node.skin().is_some() || mesh.primitives().any(|p| p.morph_targets().len() > 0) {
+                    self.warn.skinned_or_morphed += 1;
+                }
+                for prim in mesh.primitives() {
+                    if let Some(prepared) = self.prepare(&mesh, &prim)? {
+                        self.place(&prepared, world);
+                    }
+                }
+            }
+            if let Some(light) = node.light() {
+                self.light(&light, node.index(), world)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// The nodes of the scene's trees that hold a mesh or a light, depth-first, each with
+    /// its world matrix (the product of the local ones from its root down). Each node is
+    /// visited once: a node reached twice (a cycle, or a node with two parents, which
+    /// would place its subtree once per path, a count that doubles with each level) is
+    /// an error.
+    fn world_matrices<'a>(
+        &self,
+        doc: &'a ::gltf::Document,
+        scene: &::gltf::Scene<'a>,
+    ) -> Result<Vec<(::gltf::Node<'a>, Mat4)>, SceneError> {
         // An explicit stack (no recursion, so a deep file cannot overflow ours) and a
         // visited mark (the crate does not reject cycles, which would never end).
         let mut seen = vec![false; doc.nodes().len()];
@@ -29,6 +73,7 @@ impl Reader {
             .map(|n| (n, Mat4::IDENTITY))
             .collect::<Vec<_>>();
         stack.reverse();
+        let mut placed = Vec::new();
         while let Some((node, parent)) = stack.pop() {
             let i = node.index();
             if std::mem::replace(&mut seen[i], true) {
@@ -40,29 +85,104 @@ impl Reader {
                     ),
                 ));
             }
-            let local = Mat4::from_cols_array_2d(&node.transform().matrix());
-            let world = parent * local;
+            let world = parent * self.local_matrix(&node)?;
             if !world.is_finite() {
                 return Err(invalid(
                     &self.file,
                     format!("node {i}: its transform (or a parent's) is not finite"),
                 ));
             }
-            if let Some(mesh) = node.mesh() {
-                if node.skin().is_some() || mesh.primitives().any(|p| p.morph_targets().len() > 0) {
-                    self.warn.skinned_or_morphed += 1;
-                }
-                for prim in mesh.primitives() {
-                    self.primitive(&mesh, &prim, &world)?;
-                }
-            }
-            if let Some(light) = node.light() {
-                self.light(&light, i, &world)?;
-            }
             let children: Vec<_> = node.children().collect();
             stack.extend(children.into_iter().rev().map(|c| (c, world)));
+            if node.mesh().is_some() || node.light().is_some() {
+                placed.push((node, world));
+            }
         }
-        Ok(())
+        Ok(placed)
+    }
+
+    /// Refuses a tree whose meshes would make more triangles than the scene may still take,
+    /// before any is made: the count comes from the accessors' declared counts (degenerate
+    /// triangles, dropped later, count too: they cost the same work), summed without
+    /// overflow. A file of a few kilobytes that places one mesh at many nodes could
+    /// otherwise ask for billions of triangles.
+    fn check_triangle_count(
+        &self,
+        doc: &::gltf::Document,
+        placed: &[(::gltf::Node, Mat4)],
+    ) -> Result<(), SceneError> {
+        // Per mesh: its triangles, and how many nodes place it.
+        let mut per_mesh: Vec<(usize, usize)> = vec![(0, 0); doc.meshes().len()];
+        let mut total = 0usize;
+        for mesh in placed.iter().filter_map(|(node, _)| node.mesh()) {
+            let Some(entry) = per_mesh.get_mut(mesh.index()) else {
+                continue;
+            };
+            if entry.1 == 0 {
+                entry.0 = mesh
+                    .primitives()
+                    .map(|p| primitive_triangles(&p))
+                    .fold(0, usize::saturating_add);
+            }
+            entry.1 += 1;
+            total = total.saturating_add(entry.0);
+        }
+        self.budget.check(total, &self.file, || {
+            let most = per_mesh
+                .iter()
+                .enumerate()
+                .max_by_key(|(_, (t, n))| t.saturating_mul(*n));
+            let detail = match most.and_then(|(m, &(t, n))| Some((doc.meshes().nth(m)?, t, n))) {
+                Some((mesh, t, n)) if n > 1 => format!(
+                    " ({} placed by {n} nodes, {t} triangles each)",
+                    mesh_label(&mesh)
+                ),
+                _ => String::new(),
+            };
+            format!("its node tree would make {total} triangles{detail}")
+        })
+    }
+
+    /// The node's local matrix: its `matrix`, or translation * rotation * scale. A rotation
+    /// whose length is further from 1 than [`MAX_ROTATION_LENGTH_ERROR`] is an error (it
+    /// would shear and scale what the node holds); one within it is normalised, so that
+    /// exporters' rounding makes an exact rotation. A rotation that is not finite is left
+    /// for the caller's check of the world matrix, which names it.
+    pub(super) fn local_matrix(&self, node: &::gltf::Node) -> Result<Mat4, SceneError> {
+        match node.transform() {
+            Transform::Matrix { matrix } => Ok(Mat4::from_cols_array_2d(&matrix)),
+            Transform::Decomposed {
+                translation,
+                rotation,
+                scale,
+            } => {
+                let q = Quat::from_array(rotation);
+                // In f64: the length of any finite f32 quaternion, without overflow.
+                let length = DQuat::from_array(rotation.map(f64::from)).length();
+                let q = if !q.is_finite() {
+                    q
+                } else if (length - 1.0).abs() <= f64::from(MAX_ROTATION_LENGTH_ERROR) {
+                    q.normalize()
+                } else {
+                    return Err(invalid(
+                        &self.file,
+                        format!(
+                            "node {}: rotation [{}, {}, {}, {}] has length {length:.6}, not 1: glTF node rotations are unit quaternions (a length within {MAX_ROTATION_LENGTH_ERROR} of 1 is normalised)",
+                            node.index(),
+                            q.x,
+                            q.y,
+                            q.z,
+                            q.w
+                        ),
+                    ));
+                };
+                Ok(Mat4::from_scale_rotation_translation(
+                    Vec3::from(scale),
+                    q,
+                    Vec3::from(translation),
+                ))
+            }
+        }
     }
 
     /// A KHR_lights_punctual light at node `node`.
@@ -100,13 +220,17 @@ impl Reader {
         Ok(())
     }
 
-    /// One primitive of `mesh` under the world matrix `world`: appends its triangles.
-    pub(super) fn primitive(
+    /// The data of one primitive of `mesh`, read and checked on its first use; `None` for
+    /// a primitive that makes no triangles (POINTS, LINES*: skipped with a warning).
+    pub(super) fn prepare(
         &mut self,
         mesh: &::gltf::Mesh,
         prim: &::gltf::Primitive,
-        world: &Mat4,
-    ) -> Result<(), SceneError> {
+    ) -> Result<Option<Rc<Prepared>>, SceneError> {
+        let key = (mesh.index(), prim.index());
+        if let Some(p) = self.shared.primitives.get(&key) {
+            return Ok(p.clone());
+        }
         let what = format!("{} primitive {}", mesh_label(mesh), prim.index());
         let mode = prim.mode();
         if !matches!(
@@ -114,25 +238,14 @@ impl Reader {
             Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
         ) {
             self.warn.not_triangles += 1;
-            return Ok(());
+            self.shared.primitives.insert(key, None);
+            return Ok(None);
         }
         let Some(pos_acc) = prim.get(&Semantic::Positions) else {
             return Err(parse(&self.file, format!("{what} has no POSITION")));
         };
-        self.check_accessor(
-            &pos_acc,
-            &format!("{what} POSITION"),
-            &[DataType::F32],
-            Dimensions::Vec3,
-        )?;
         let nrm_acc = prim.get(&Semantic::Normals);
         if let Some(acc) = &nrm_acc {
-            self.check_accessor(
-                acc,
-                &format!("{what} NORMAL"),
-                &[DataType::F32],
-                Dimensions::Vec3,
-            )?;
             if acc.count() != pos_acc.count() {
                 return Err(parse(
                     &self.file,
@@ -144,60 +257,59 @@ impl Reader {
                 ));
             }
         }
-        if let Some(acc) = prim.indices() {
-            self.check_accessor(
-                &acc,
-                &format!("{what} indices"),
-                &[DataType::U8, DataType::U16, DataType::U32],
-                Dimensions::Scalar,
-            )?;
-        }
-
-        let buffers = &self.buffers;
-        let reader = prim.reader(|b| buffers.get(b.index()).map(|d| d.0.as_slice()));
-        let internal = |of: &str| {
-            parse(
-                &self.file,
-                format!("{what}: internal error: cannot read the {of} accessor"),
-            )
-        };
-        let positions: Vec<Vec3> = reader
-            .read_positions()
-            .ok_or_else(|| internal("POSITION"))?
-            .map(Vec3::from)
-            .collect();
-        let normals: Option<Vec<Vec3>> = match &nrm_acc {
-            Some(_) => Some(
-                reader
-                    .read_normals()
-                    .ok_or_else(|| internal("NORMAL"))?
-                    .map(Vec3::from)
-                    .collect(),
-            ),
+        let positions = self.vec3s(&pos_acc, &format!("{what} POSITION"))?;
+        let normals = match &nrm_acc {
+            Some(acc) => Some(self.vec3s(acc, &format!("{what} NORMAL"))?),
             None => None,
         };
-        let indices: Vec<u32> = match prim.indices() {
-            Some(_) => reader
-                .read_indices()
-                .ok_or_else(|| internal("indices"))?
-                .into_u32()
-                .collect(),
-            None => (0..positions.len() as u32).collect(),
-        };
         let nv = positions.len();
-        if let Some((k, &i)) = indices.iter().enumerate().find(|(_, &i)| i as usize >= nv) {
-            return Err(parse(
-                &self.file,
-                format!("{what}: index {i} (element {k} of the indices) out of range: POSITION has {nv} vertices"),
-            ));
-        }
-
-        let corners = triangulate(mode, &indices);
-        if mode == Mode::Triangles && !indices.len().is_multiple_of(3) {
-            self.warn.leftover_indices += 1;
+        let corners = match prim.indices() {
+            Some(acc) => {
+                let indices = self.indices(&acc, &format!("{what} indices"))?;
+                if let Some((k, &i)) = indices.iter().enumerate().find(|(_, &i)| i as usize >= nv) {
+                    return Err(parse(
+                        &self.file,
+                        format!("{what}: index {i} (element {k} of the indices) out of range: POSITION has {nv} vertices"),
+                    ));
+                }
+                if mode == Mode::Triangles && !indices.len().is_multiple_of(3) {
+                    self.warn.leftover_indices += 1;
+                }
+                triangulate(mode, &indices)
+            }
+            None => {
+                // Vertex counts fit in u32: the scene's triangle limit was checked first.
+                let in_order: Vec<u32> = (0..nv as u32).collect();
+                if mode == Mode::Triangles && !nv.is_multiple_of(3) {
+                    self.warn.leftover_indices += 1;
+                }
+                triangulate(mode, &in_order)
+            }
+        };
+        for t in &corners {
+            if let Some(&i) = t.iter().find(|&&i| !positions[i as usize].is_finite()) {
+                return Err(invalid(
+                    &self.file,
+                    format!(
+                        "{what}: a triangle uses vertex {i} whose position {} is not finite",
+                        fmt3(positions[i as usize].into())
+                    ),
+                ));
+            }
         }
         let material = self.material(prim.material())?;
+        let prepared = Rc::new(Prepared {
+            positions,
+            normals,
+            corners,
+            material,
+        });
+        self.shared.primitives.insert(key, Some(prepared.clone()));
+        Ok(Some(prepared))
+    }
 
+    /// Appends the triangles of a primitive under the world matrix `world`.
+    pub(super) fn place(&mut self, p: &Prepared, world: &Mat4) {
         // Normals go through the cofactor matrix, det * M^-T: defined even when M is
         // singular, and with the sign of det undone it is the inverse transpose's direction.
         let m3 = Mat3::from_mat4(*world);
@@ -210,31 +322,20 @@ impl Reader {
         }
 
         let mut count = 0usize;
-        for mut t in corners {
+        for &(mut t) in &p.corners {
             if mirrored {
                 // The glTF spec: a negative determinant makes front faces clockwise; keep
                 // the geometric normal on the side of the (inverse transposed) normals.
                 t.swap(1, 2);
             }
-            let local = t.map(|i| positions[i as usize]);
-            if let Some(k) = (0..3).find(|&k| !local[k].is_finite()) {
-                return Err(invalid(
-                    &self.file,
-                    format!(
-                        "{what}: a triangle uses vertex {} whose position {} is not finite",
-                        t[k],
-                        fmt3(local[k].into())
-                    ),
-                ));
-            }
-            let v = local.map(|p| world.transform_point3(p));
-            // A world transform may still make a vertex non-finite: then it is dropped too.
+            let v = t.map(|i| world.transform_point3(p.positions[i as usize]));
+            // A world transform may make a vertex non-finite: then it is dropped too.
             let Some(ng) = crate::scene::geometric_normal(&v) else {
                 self.warn.degenerate += 1;
                 continue;
             };
             let mut n = [ng; 3];
-            if let Some(normals) = &normals {
+            if let Some(normals) = &p.normals {
                 for (k, nk) in n.iter_mut().enumerate() {
                     match (normal_matrix * normals[t[k] as usize]).try_normalize() {
                         Some(x) => *nk = x,
@@ -245,12 +346,25 @@ impl Reader {
             self.out.triangles.push(Triangle {
                 v,
                 n,
-                material: material as u32,
+                material: p.material as u32,
             });
             count += 1;
         }
-        self.out.materials[material].triangles += count;
-        Ok(())
+        self.out.materials[p.material].triangles += count;
+    }
+}
+
+/// The triangles a primitive makes, from its accessors' declared counts (nothing is
+/// read): what [`triangulate`] would give.
+fn primitive_triangles(prim: &::gltf::Primitive) -> usize {
+    let n = match prim.indices() {
+        Some(acc) => acc.count(),
+        None => prim.get(&Semantic::Positions).map_or(0, |acc| acc.count()),
+    };
+    match prim.mode() {
+        Mode::Triangles => n / 3,
+        Mode::TriangleStrip | Mode::TriangleFan => n.saturating_sub(2),
+        _ => 0,
     }
 }
 
