@@ -658,3 +658,38 @@ fn an_image_named_by_many_entries_is_read_once() {
 }
 
 include!("common/tiny_png.rs");
+
+// ---------------------------------------------------------------------------------------
+// Scenes that 32-bit floats cannot trace
+// ---------------------------------------------------------------------------------------
+
+#[test]
+fn a_small_scene_far_from_the_origin_is_refused_and_a_far_one_near_it_loads() {
+    let dir = TestDir::new("far");
+    let quad = |offset: f64, size: f64| {
+        let v = |x: f64, y: f64| format!("v {} {} 0\n", offset + x * size, offset + y * size);
+        format!(
+            "{}{}{}{}f 1 2 3\nf 1 3 4\n",
+            v(0.0, 0.0),
+            v(1.0, 0.0),
+            v(1.0, 1.0),
+            v(0.0, 1.0)
+        )
+    };
+    let toml = |mesh: &str| {
+        format!("{CAMERA}\n{LIGHT}\n[[mesh]]\npath = \"{mesh}\"\ndefault_material = \"white\"\n[materials.white]\ndiffuse = [0.5, 0.5, 0.5]\n")
+    };
+    // A 1-unit square a million units out: f32 points are 0.06 apart there.
+    dir.write("far.obj", quad(1e6, 1.0));
+    expect_err(
+        dir.load(&toml("far.obj")),
+        "scene.toml",
+        &["nearer the origin", "1.000e6"],
+    );
+    // The same square at the origin, and at 1e-9 or 1e12 of its size, loads.
+    for size in [1.0, 1e-9, 1e12] {
+        dir.write("near.obj", quad(0.0, size));
+        let s = dir.load(&toml("near.obj")).unwrap();
+        assert_eq!(s.triangles.len(), 2, "{size}");
+    }
+}

@@ -137,10 +137,6 @@ impl TriangleBudget {
     }
 }
 
-/// Coordinates beyond which ray tests may overflow (2^62, ~4.6e18; an edge of 9e18 was
-/// already missed on lavapipe).
-const FAR_COORDINATE: f32 = 4.611686e18;
-
 // ---------------------------------------------------------------------------------------
 // Entry points
 // ---------------------------------------------------------------------------------------
@@ -394,19 +390,7 @@ pub(super) fn load_scene_str_within(
             "the scene has no triangles (its meshes have no faces, or only degenerate ones)",
         ));
     }
-    // Ray tests multiply coordinates (relative to the ray's origin) in f32: past ~1e19
-    // the products overflow and rays miss the triangle. Valid input, so kept, but said.
-    let far = triangles
-        .iter()
-        .filter(|t| t.v.iter().any(|p| p.abs().max_element() > FAR_COORDINATE))
-        .count();
-    if far > 0 {
-        log::warn!(
-            "{name}: {far} triangles have coordinates beyond {FAR_COORDINATE:e}: rays (32-bit floats) may miss them"
-        );
-    }
-
-    Ok(Scene {
+    let scene = Scene {
         camera,
         film,
         triangles,
@@ -414,7 +398,30 @@ pub(super) fn load_scene_str_within(
         lights,
         source: name.to_string(),
         files,
-    })
+    };
+    check_scale(&scene)?;
+    Ok(scene)
+}
+
+/// Errors where 32-bit floats cannot trace the scene (a small scene far from the origin,
+/// [`crate::trace_scale::check_precision`]); warns where its ray offsets, set by its
+/// farthest coordinate, are large against what the camera looks at (a far triangle among
+/// small ones). Any size in itself is traced (see [`crate::trace_scale`]).
+fn check_scale(scene: &Scene) -> Result<(), SceneError> {
+    let (lo, hi) = scene.bounds();
+    crate::trace_scale::check_precision(lo, hi)
+        .map_err(|e| SceneError::invalid(Location::file(&scene.source), e))?;
+    let floor = crate::bvh::offset_floor(lo, hi);
+    let view = scene.camera.eye.distance(scene.camera.target);
+    if floor > view * crate::trace_scale::MAX_OFFSET_FRACTION {
+        log::warn!(
+            "{}: its farthest coordinates ({:.3e}) make ray origins move {floor:.3e} off surfaces, more than 1/{} of the camera's distance to its target ({view:.3e}): shadows near the camera may detach or vanish",
+            scene.source,
+            lo.abs().max(hi.abs()).max_element(),
+            (1.0 / crate::trace_scale::MAX_OFFSET_FRACTION) as u32
+        );
+    }
+    Ok(())
 }
 
 // ---------------------------------------------------------------------------------------

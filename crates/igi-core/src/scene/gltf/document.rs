@@ -5,8 +5,8 @@ use std::borrow::Cow;
 use std::collections::HashMap;
 use std::path::Path;
 
-use ::gltf::json::deserialize::{from_slice, from_value};
-use ::gltf::json::{Root, Value};
+use ::gltf::json::deserialize::from_slice;
+use ::gltf::json::Root;
 use ::gltf::Semantic;
 
 use super::accessors::{ReadStats, Reader, Shared};
@@ -77,15 +77,8 @@ pub(super) fn document(bytes: &[u8], file: &str) -> Result<::gltf::Gltf, SceneEr
     } else {
         (Cow::Borrowed(bytes), None)
     };
-    let root = match from_slice::<Root>(&json) {
-        Ok(root) => root,
-        Err(e) => match with_extras_as_objects(&json) {
-            Some(Ok(root)) => root,
-            // The file has other faults: this error is about one of them.
-            Some(Err(other)) => return Err(error(::gltf::Error::Deserialize(other))),
-            None => return Err(error(::gltf::Error::Deserialize(e))),
-        },
-    };
+    // `extras` may be any JSON value (the gltf crate's `extras` feature keeps it raw).
+    let root = from_slice::<Root>(&json).map_err(|e| error(::gltf::Error::Deserialize(e)))?;
     // gltf 1.4's validation reads `accessors[POSITION]` with `[]`: check that index first.
     for (m, mesh) in root.meshes.iter().enumerate() {
         for (p, prim) in mesh.primitives.iter().enumerate() {
@@ -107,38 +100,6 @@ pub(super) fn document(bytes: &[u8], file: &str) -> Result<::gltf::Gltf, SceneEr
     let document =
         ::gltf::Document::from_json(root).map_err(|e| document_error(e, file, is_glb))?;
     Ok(::gltf::Gltf { document, blob })
-}
-
-/// The document of `json` with every `extras` that is not an object replaced by an empty
-/// object, or `None` when it has no such `extras` (or is not JSON). The glTF spec lets
-/// `extras` be any JSON value, but gltf 1.4 (without its `extras` feature) reads it into
-/// an empty struct, which refuses an array, a string, a number, a boolean or null. The
-/// renderer reads no `extras`, so their values do not matter; an object's contents are
-/// application data and are left alone. Only called once the plain reading failed, so a
-/// file without such `extras` is parsed once.
-pub(super) fn with_extras_as_objects(json: &[u8]) -> Option<Result<Root, ::gltf::json::Error>> {
-    let mut value: Value = from_slice(json).ok()?;
-    let mut replaced = 0usize;
-    // An explicit stack: JSON nesting is bounded by serde_json (128 levels), but no
-    // recursion is needed.
-    let mut stack = vec![&mut value];
-    while let Some(v) = stack.pop() {
-        match v {
-            Value::Object(map) => {
-                for (key, child) in map.iter_mut() {
-                    if key != "extras" {
-                        stack.push(child);
-                    } else if !child.is_object() {
-                        *child = Value::Object(Default::default());
-                        replaced += 1;
-                    }
-                }
-            }
-            Value::Array(items) => stack.extend(items.iter_mut()),
-            _ => {}
-        }
-    }
-    (replaced > 0).then(|| from_value(value))
 }
 
 /// Reads one glTF file (see [`super::load_gltf_bytes`]) whose triangles must fit in
