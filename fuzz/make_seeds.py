@@ -125,4 +125,42 @@ def glb(json_text, bin_data):
 
 write("gltf", "tri.glb", glb(doc(None, glb=True), tri))
 write("gltf", "light.glb", glb(doc(None, light, glb=True), tri))
+
+# --- exr and compare: small uncompressed scanline OpenEXR files -----------------------
+def exr(width, height, channels="BGR", half=False, value=0.25):
+    """An uncompressed scanline OpenEXR image of `channels` (sorted, as the format wants),
+    every sample `value`, in 16-bit (half) or 32-bit floats."""
+    def attr(name, kind, data):
+        return name.encode() + b"\0" + kind.encode() + b"\0" + struct.pack("<i", len(data)) + data
+    ptype = 1 if half else 2
+    chlist = b"".join(c.encode() + b"\0" + struct.pack("<iB3xii", ptype, 0, 1, 1) for c in sorted(channels)) + b"\0"
+    box = struct.pack("<iiii", 0, 0, width - 1, height - 1)
+    header = (attr("channels", "chlist", chlist) + attr("compression", "compression", b"\0")
+              + attr("dataWindow", "box2i", box) + attr("displayWindow", "box2i", box)
+              + attr("lineOrder", "lineOrder", b"\0") + attr("pixelAspectRatio", "float", struct.pack("<f", 1.0))
+              + attr("screenWindowCenter", "v2f", struct.pack("<ff", 0, 0))
+              + attr("screenWindowWidth", "float", struct.pack("<f", 1.0)) + b"\0")
+    start = 8 + len(header) + 8 * height
+    sample = struct.pack("<e", value) if half else struct.pack("<f", value)
+    line = sample * (width * len(channels))
+    chunks, offsets = b"", b""
+    for y in range(height):
+        offsets += struct.pack("<Q", start + len(chunks))
+        chunks += struct.pack("<ii", y, len(line)) + line
+    return b"\x76\x2f\x31\x01" + struct.pack("<I", 2) + header + offsets + chunks
+
+
+images = {
+    "rgb-float-4x3.exr": exr(4, 3),
+    "rgb-half-3x2.exr": exr(3, 2, half=True),
+    "rgba-float-2x2.exr": exr(2, 2, "ABGR", value=1.5),
+    "y-float-1x1.exr": exr(1, 1, "Y"),
+}
+for name, data in images.items():
+    write("exr", name, data)
+a, b = images["rgb-float-4x3.exr"], exr(4, 3, value=0.5)
+write("compare", "same-size.bin", struct.pack("<I", len(a)) + a + b)
+c = images["rgb-half-3x2.exr"]
+write("compare", "other-size.bin", struct.pack("<I", len(a)) + a + c)
+
 print("seeds written under", os.path.join(HERE, "corpus"))

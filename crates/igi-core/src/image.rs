@@ -285,6 +285,26 @@ pub fn rel_mse(image: &Image, reference: &Image) -> Result<f64, ImageError> {
     Ok(sum / (3 * image.data.len().max(1)) as f64)
 }
 
+/// What `igi compare` reports of an image against a reference of the same size.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Comparison {
+    pub rel_mse: f64,
+    /// Channel means of the image and of the reference.
+    pub means: ([f64; 3], [f64; 3]),
+    pub pixels: PixelDifferences,
+}
+
+impl Comparison {
+    /// `image` against `reference`; an error where their sizes differ.
+    pub fn of(image: &Image, reference: &Image) -> Result<Comparison, ImageError> {
+        Ok(Comparison {
+            rel_mse: rel_mse(image, reference)?,
+            means: (image.mean(), reference.mean()),
+            pixels: pixel_differences(image, reference)?,
+        })
+    }
+}
+
 /// Where two images of one size differ, pixel by pixel: what `igi compare` reports
 /// beside the relMSE, which rounds small differences to 0 and does not tell a few wrong
 /// pixels from many slightly different ones.
@@ -562,5 +582,81 @@ mod tests {
             "{e}"
         );
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// An uncompressed scanline OpenEXR file of float RGB whose header declares a
+    /// `width` x `height` data window and whose offset table and pixels are those of
+    /// `lines` lines of `width` pixels (fewer than declared makes a damaged file).
+    fn declared_exr(width: i32, height: i32, lines: i32) -> Vec<u8> {
+        let attr = |name: &str, kind: &str, data: &[u8]| {
+            let mut a = [name.as_bytes(), b"\0", kind.as_bytes(), b"\0"].concat();
+            a.extend((data.len() as i32).to_le_bytes());
+            a.extend(data);
+            a
+        };
+        let mut chlist = vec![];
+        for c in ["B", "G", "R"] {
+            chlist.extend(c.as_bytes());
+            chlist.push(0);
+            chlist.extend(2i32.to_le_bytes());
+            chlist.extend([0u8; 4]);
+            chlist.extend(1i32.to_le_bytes());
+            chlist.extend(1i32.to_le_bytes());
+        }
+        chlist.push(0);
+        let window: Vec<u8> = [0, 0, width - 1, height - 1]
+            .iter()
+            .flat_map(|v| v.to_le_bytes())
+            .collect();
+        let mut header = [
+            attr("channels", "chlist", &chlist),
+            attr("compression", "compression", &[0]),
+            attr("dataWindow", "box2i", &window),
+            attr("displayWindow", "box2i", &window),
+            attr("lineOrder", "lineOrder", &[0]),
+            attr("pixelAspectRatio", "float", &1f32.to_le_bytes()),
+            attr("screenWindowCenter", "v2f", &[0; 8]),
+            attr("screenWindowWidth", "float", &1f32.to_le_bytes()),
+        ]
+        .concat();
+        header.push(0);
+        let mut file = vec![0x76, 0x2f, 0x31, 0x01, 2, 0, 0, 0];
+        file.extend(&header);
+        let line_bytes = 12 * width as usize;
+        let start = file.len() + 8 * lines as usize;
+        for y in 0..lines as usize {
+            file.extend(((start + y * (8 + line_bytes)) as u64).to_le_bytes());
+        }
+        for y in 0..lines {
+            file.extend(y.to_le_bytes());
+            file.extend((line_bytes as i32).to_le_bytes());
+            file.extend(std::iter::repeat_n(0u8, line_bytes));
+        }
+        file
+    }
+
+    #[test]
+    fn exr_headers_cannot_ask_for_more_than_the_file_holds() {
+        let path = Path::new("x.exr");
+        // A whole small file reads.
+        let ok = Image::read_exr_bytes(&declared_exr(5, 3, 3), path).unwrap();
+        assert_eq!((ok.width, ok.height), (5, 3));
+        // 1e10 pixels declared: refused from the header, before any allocation.
+        let e = Image::read_exr_bytes(&declared_exr(100_000, 100_000, 1), path)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("x.exr") && e.contains("igi reads at most"),
+            "{e}"
+        );
+        // Within the pixel limit, but 10,000 lines declared of a file that has 2: its
+        // offset table alone would be longer than the file.
+        let e = Image::read_exr_bytes(&declared_exr(100, 10_000, 2), path)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("offset tables") && e.contains("cut short"),
+            "{e}"
+        );
     }
 }
