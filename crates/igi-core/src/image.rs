@@ -120,19 +120,27 @@ impl Image {
             });
         }
         check_exr_sizes(bytes).map_err(err)?;
-        let image = exr::prelude::read()
-            .no_deep_data()
-            .largest_resolution_level()
-            .rgba_channels(
-                |size, _| Self::new(size.0 as u32, size.1 as u32),
-                |img: &mut Self, pos, (r, g, b, _a): (f32, f32, f32, f32)| {
-                    let i = pos.1 * img.width as usize + pos.0;
-                    img.data[i] = [r, g, b];
-                },
-            )
-            .first_valid_layer()
-            .all_attributes()
-            .from_buffered(std::io::Cursor::new(bytes))
+        // On this thread (not the decoder's thread pool, where a panic aborts the
+        // process) and inside catch_unwind: the decoder's B44 code was found to overflow
+        // an integer on damaged data, which panics where overflow checks are on.
+        let decode = || {
+            exr::prelude::read()
+                .no_deep_data()
+                .largest_resolution_level()
+                .rgba_channels(
+                    |size, _| Self::new(size.0 as u32, size.1 as u32),
+                    |img: &mut Self, pos, (r, g, b, _a): (f32, f32, f32, f32)| {
+                        let i = pos.1 * img.width as usize + pos.0;
+                        img.data[i] = [r, g, b];
+                    },
+                )
+                .first_valid_layer()
+                .all_attributes()
+                .non_parallel()
+                .from_buffered(std::io::Cursor::new(bytes))
+        };
+        let image = std::panic::catch_unwind(decode)
+            .map_err(|_| err("the OpenEXR decoder failed on its pixel data (damaged?)".into()))?
             .map_err(|e| err(e.to_string()))?;
         Ok(image.layer_data.channel_data.pixels)
     }

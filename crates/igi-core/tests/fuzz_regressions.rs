@@ -173,3 +173,20 @@ fn gltf_inputs() {
     run_all("gltf", |bytes| load_gltf_bytes(bytes, &gltf).map(|_| ()));
 }
 include!("common/tiny_png.rs");
+
+/// Target `exr` (and `compare`, which reads the same way): the bytes to the OpenEXR
+/// reader. Its decoder's own panics on damaged data are caught there (see
+/// `Image::read_exr_bytes`), so they are not counted: the file must end in one error.
+#[test]
+fn exr_inputs() {
+    let mut problems = Vec::new();
+    for (name, bytes) in inputs("exr") {
+        let r = igi_core::image::Image::read_exr_bytes(&bytes, Path::new("fuzz.exr"));
+        match (name.starts_with("ok-"), r) {
+            (true, Ok(_)) | (false, Err(_)) => {}
+            (true, Err(e)) => problems.push(format!("{name}: expected to load, got: {e}")),
+            (false, Ok(_)) => problems.push(format!("{name}: expected an error, it loaded")),
+        }
+    }
+    assert!(problems.is_empty(), "exr:\n{}", problems.join("\n"));
+}
