@@ -21,6 +21,8 @@ pub struct SceneBuffers {
     pub lights: wgpu::Buffer,
     /// The ray counters of scene.wgsl (8 x u32).
     pub ray_counters: wgpu::Buffer,
+    /// The spare ray counters of [`SceneBuffers::beside_bind_groups`], in their order.
+    pub spare_ray_counters: Vec<wgpu::Buffer>,
     /// Bytes held on the GPU by the scene.
     pub bytes: u64,
 }
@@ -182,6 +184,7 @@ impl SceneBuffers {
             light_count: lights.len() as u32,
             lights: lights_buffer,
             ray_counters,
+            spare_ray_counters: spare_counters,
             bytes,
         })
     }

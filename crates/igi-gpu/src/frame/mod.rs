@@ -512,6 +512,7 @@ impl Renderer {
         for submission in in_flight {
             wait(submission)?;
         }
+        self.check_walks(ctx)?;
         let image = self.read_image(ctx)?;
         let vpl_count = self.vpl_count(ctx)?;
         let timing = self.profiler.read(ctx, &names)?;
@@ -527,6 +528,28 @@ impl Renderer {
             stages,
             frame_ms,
         })
+    }
+
+    /// Error where a software adapter cut BVH walks of the frames so far short (its loop
+    /// limit, see traverse.wgsl's LOOP_CUTS_COUNTED): their images would be wrong. No
+    /// work on GPUs, which count nothing there.
+    pub fn check_walks(&self, ctx: &GpuContext) -> Result<(), GpuError> {
+        if !self.software {
+            return Ok(());
+        }
+        let mut cut = 0u64;
+        for counters in
+            std::iter::once(&self.scene.ray_counters).chain(&self.scene.spare_ray_counters)
+        {
+            let counts: Vec<u32> = ctx.read_buffer(counters)?;
+            cut += counts[CUT_WALKS] as u64;
+        }
+        if cut == 0 {
+            return Ok(());
+        }
+        Err(GpuError::Limit(format!(
+            "the software adapter ended {cut} ray traversals before they were done (llvmpipe stops a shader after 65,535 loop iterations, and this scene's BVH needs more: many overlapping triangles), so the image would be wrong; render on a GPU, or with fewer overlapping triangles"
+        )))
     }
 
     /// GPU times of the last submitted frame's stages `names` (as [`Renderer::submit_frame`]
@@ -724,6 +747,9 @@ fn check_light_power(sum: f32, scale: TraceScale) -> Result<(), GpuError> {
         scale.factor
     )))
 }
+
+/// scene.wgsl's counter of walks cut short (`CUT_WALKS`).
+const CUT_WALKS: usize = 7;
 
 /// Reject settings the passes cannot honour, by igi-core's validation (the one the
 /// command, the bench and the viewer run): the accelerations' parameters, and a mirror

@@ -115,7 +115,11 @@ pub fn try_compose(
     let wgsl = resolve::resolve(name, source, module)?;
     Ok(match params {
         ParamsBinding::Uniform => wgsl,
-        ParamsBinding::Storage => wgsl.replace(UNIFORM_DECLARATION, "var<storage, read>"),
+        // Software adapters: parameter blocks in storage buffers, and walks that count
+        // being cut short by llvmpipe's loop limit (traverse.wgsl's LOOP_CUTS_COUNTED).
+        ParamsBinding::Storage => wgsl
+            .replace(UNIFORM_DECLARATION, "var<storage, read>")
+            .replace(LOOP_CUTS_OFF, LOOP_CUTS_ON),
     })
 }
 
@@ -137,6 +141,11 @@ pub enum ParamsBinding {
 
 /// How WGSL declares a parameter block; [`ParamsBinding::Storage`] rewrites it.
 const UNIFORM_DECLARATION: &str = "var<uniform>";
+
+/// traverse.wgsl's switch of the loop-cut counting, off, and as software adapters'
+/// shaders have it.
+const LOOP_CUTS_OFF: &str = "const LOOP_CUTS_COUNTED: bool = false;";
+const LOOP_CUTS_ON: &str = "const LOOP_CUTS_COUNTED: bool = true;";
 
 impl ParamsBinding {
     /// Both bindings, GPUs' first: what the shader tests go through.
@@ -182,4 +191,29 @@ pub fn all_shaders() -> Vec<(&'static str, String)> {
         .iter()
         .map(|pass| (pass.name, compose(pass)))
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The software composition turns the loop-cut counting on in every pass that walks
+    /// the BVH: the text it replaces is traverse.wgsl's.
+    #[test]
+    fn software_shaders_count_cut_walks() {
+        let traverse = module("traverse").expect("traverse module");
+        assert_eq!(traverse.matches(LOOP_CUTS_OFF).count(), 1);
+        for pass in SOURCES {
+            let gpu = compose_for(pass, ParamsBinding::Uniform);
+            let software = compose_for(pass, ParamsBinding::Storage);
+            if gpu.contains(LOOP_CUTS_OFF) {
+                assert!(
+                    software.contains(LOOP_CUTS_ON) && !software.contains(LOOP_CUTS_OFF),
+                    "{}",
+                    pass.name
+                );
+            }
+            assert!(!gpu.contains(LOOP_CUTS_ON), "{}", pass.name);
+        }
+    }
 }

@@ -39,4 +39,6 @@ struct PointLight {
 @group(0) @binding(4) var<storage, read> lights: array<PointLight>;
 // Rays traced per kind (ray_count.wgsl's RAY_* indices), counted only when
 // params.count_rays is set: one atomic add per invocation and kind, in an untimed frame.
+// Entry CUT_WALKS counts walks a software adapter cut short (traverse.wgsl), always.
 @group(0) @binding(5) var<storage, read_write> ray_counters: array<atomic<u32>, 8>;
+const CUT_WALKS: u32 = 7u;

@@ -49,6 +49,22 @@ const BOX_TFAR_SCALE: f32 = 1.0000003576278687;
 // in place of BOX_TFAR_SCALE where tmax = 1 (trace_segment).
 const SEGMENT_PAD: f32 = 0.000000476837158203125;
 
+// Whether walks report being cut short. llvmpipe (the software adapter) ends every loop
+// of a shader invocation once the invocation has run 65,535 loop iterations in all, and
+// the code after the loop runs on: a walk cut so would answer "no hit", and light would
+// pass through a shadow in silence (a few tens of thousands of overlapping triangles are
+// enough). A cut walk adds one to ray_counters[CUT_WALKS], and the renderer refuses the
+// frame (Renderer::check_walks). The software adapters' composition sets this true
+// (shader::try_compose); on GPUs, which have no such limit, the checks fold away. The
+// CPU twin has no limit and no such check.
+const LOOP_CUTS_COUNTED: bool = false;
+
+fn walk_cut() {
+    if (LOOP_CUTS_COUNTED) {
+        atomicAdd(&ray_counters[CUT_WALKS], 1u);
+    }
+}
+
 // Wächter-Binder offset constants: near-origin threshold, absolute offset, ulp count.
 const OFFSET_ORIGIN: f32 = 0.03125;
 const OFFSET_FLOAT_SCALE: f32 = 0.0000152587890625;
@@ -267,18 +283,23 @@ fn slot_rows(slot: u32, r: TraceRay) -> WoopRows {
 // The triangles of a leaf in slot order; equal distances keep the first hit.
 fn leaf_closest(first: u32, count: u32, r: TraceRay, hit_in: Hit) -> Hit {
     var hit = hit_in;
-    for (var slot = first; slot < first + count; slot++) {
+    var slot = first;
+    for (; slot < first + count; slot++) {
         let rows = slot_rows(slot, r);
         let h = intersect_triangle(r, rows.x, rows.y, rows.z, hit.t);
         if (h.x > 0.0) {
             hit = Hit(h.x, slot, h.y, h.z);
         }
     }
+    if (LOOP_CUTS_COUNTED && slot < first + count) {
+        walk_cut();
+    }
     return hit;
 }
 
 fn leaf_any(first: u32, count: u32, r: TraceRay, tmax: f32, boxes: bool) -> bool {
-    for (var slot = first; slot < first + count; slot++) {
+    var slot = first;
+    for (; slot < first + count; slot++) {
         let i = 3u * slot;
         if (boxes) {
             // The triangle's box: per axis the extremes of that axis's row.
@@ -296,6 +317,9 @@ fn leaf_any(first: u32, count: u32, r: TraceRay, tmax: f32, boxes: bool) -> bool
         if (h.x > 0.0) {
             return true;
         }
+    }
+    if (LOOP_CUTS_COUNTED && slot < first + count) {
+        walk_cut();
     }
     return false;
 }
@@ -332,6 +356,8 @@ fn trace_closest(stack: ptr<function, WalkStack>, origin: vec3<f32>, dir: vec3<f
     let r = make_ray(origin, dir, 0.0);
     var sp = 0u;
     var node = 0u;
+    // Set where the walk ends by itself (see LOOP_CUTS_COUNTED).
+    var walked = false;
     loop {
         let n = bvh_nodes[node];
         let ta = box_near(n.a_min, n.a_max, r, hit.t);
@@ -365,12 +391,16 @@ fn trace_closest(stack: ptr<function, WalkStack>, origin: vec3<f32>, dir: vec3<f
         }
         if (next == NO_HIT) {
             if (sp == 0u) {
+                walked = true;
                 break;
             }
             sp -= 1u;
             next = (*stack)[sp];
         }
         node = next;
+    }
+    if (LOOP_CUTS_COUNTED && !walked) {
+        walk_cut();
     }
     return hit;
 }
@@ -427,6 +457,8 @@ fn walk_any(stack: ptr<function, WalkStack>, origin: vec3<f32>, dir: vec3<f32>, 
         }
         node = next;
     }
+    // Reached only where the loop was cut short (every walk's own end returns above).
+    walk_cut();
     return false;
 }
 

@@ -466,6 +466,8 @@ impl Viewer {
                 None => self.stats.stages.clear(),
             }
             self.stats.vpl_count = self.renderer.vpl_count(&self.ctx)?;
+            // A software adapter's cut walks end the viewer with the renderer's error.
+            self.renderer.check_walks(&self.ctx)?;
             self.accumulated += 1;
             self.frames_rendered += 1;
             self.applied = Some((settings.clone(), camera, self.state.lights.clone()));
