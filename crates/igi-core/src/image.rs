@@ -213,19 +213,40 @@ impl Image {
 /// 16,384 x 8,192 image), 1.5 GiB as RGB floats, plus what the decoder holds beside.
 pub const MAX_EXR_PIXELS: u64 = 1 << 27;
 
+/// The most an OpenEXR file's pixel data can expand when decoded, rounded up: deflate
+/// (ZIP, ZIPS, PXR24) reaches about 1,032 to 1, PIZ's Huffman code with its runs about
+/// 450, RLE 64, B44 11; decoding to RGB floats can double half samples.
+pub const MAX_EXR_EXPANSION: u64 = 2048;
+
+/// Decoded sizes up to this many bytes (64 MiB) are read from files of any length: the
+/// expansion bound only matters for larger images.
+const EXR_BOMB_FLOOR: u64 = 64 << 20;
+
 /// Errors where the headers of OpenEXR `bytes` declare more than igi reads or more than
 /// the file can hold, from the headers alone: a layer of more than [`MAX_EXR_PIXELS`],
-/// or more blocks than the file has room for in its offset tables (8 bytes a block), so
-/// that a small file cannot make the decoder allocate for a huge image.
+/// more pixels than the file's length can decode to ([`MAX_EXR_EXPANSION`]), or more
+/// blocks than the file has room for in its offset tables (8 bytes a block), so that a
+/// small file cannot make the decoder allocate for a huge image.
 fn check_exr_sizes(bytes: &[u8]) -> Result<(), String> {
     let meta = exr::meta::MetaData::read_from_buffered(bytes, false).map_err(|e| e.to_string())?;
     let mut blocks = 0u64;
+    let most_decoded = (bytes.len() as u64)
+        .saturating_mul(MAX_EXR_EXPANSION)
+        .max(EXR_BOMB_FLOOR);
     for h in &meta.headers {
         let (w, h_px) = (h.layer_size.0 as u64, h.layer_size.1 as u64);
         let pixels = w.saturating_mul(h_px);
         if pixels > MAX_EXR_PIXELS {
             return Err(format!(
                 "its header declares a {w} x {h_px} image ({pixels} pixels); igi reads at most {MAX_EXR_PIXELS}"
+            ));
+        }
+        // What reading it allocates: the image as RGB floats.
+        let decoded = pixels.saturating_mul(12);
+        if decoded > most_decoded {
+            return Err(format!(
+                "its header declares a {w} x {h_px} image ({decoded} bytes as RGB floats) in a file of {} bytes: more than any OpenEXR compression expands to (at most {MAX_EXR_EXPANSION} times); the file is damaged",
+                bytes.len()
             ));
         }
         blocks = blocks.saturating_add(h.chunk_count as u64);
@@ -657,6 +678,11 @@ mod tests {
             e.contains("x.exr") && e.contains("igi reads at most"),
             "{e}"
         );
+        // 25 M pixels (300 MB as floats) declared in a file of a few kilobytes.
+        let e = Image::read_exr_bytes(&declared_exr(5_000, 5_000, 0), path)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("more than any OpenEXR compression"), "{e}");
         // Within the pixel limit, but 10,000 lines declared of a file that has 2: its
         // offset table alone would be longer than the file.
         let e = Image::read_exr_bytes(&declared_exr(100, 10_000, 2), path)
