@@ -8,15 +8,7 @@ use igi_core::image::{Comparison, Image};
 use libfuzzer_sys::fuzz_target;
 use std::path::Path;
 
-/// libfuzzer-sys's panic hook aborts on every panic, also one the reader catches (it
-/// catches the decoder's, see `read_exr_bytes`); the default hook lets those be, and a
-/// panic that escapes the reader still ends the run as a crash.
-fn default_panic_hook() {
-    static ONCE: std::sync::Once = std::sync::Once::new();
-    ONCE.call_once(|| {
-        let _ = std::panic::take_hook();
-    });
-}
+include!("default_panic_hook.rs");
 
 fuzz_target!(|data: &[u8]| {
     default_panic_hook();

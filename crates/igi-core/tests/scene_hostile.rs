@@ -3,11 +3,10 @@
 //! that quote huge file-provided text, valid files that were refused, and bad files that
 //! were accepted. Each test writes its own files into a temporary directory.
 
-use std::path::PathBuf;
-use std::sync::atomic::{AtomicUsize, Ordering};
+#[path = "common/test_dir.rs"]
+mod test_dir;
 
-use igi_core::scene::loader::{load_scene, SceneError};
-use igi_core::scene::Scene;
+use test_dir::{expect_err, TestDir, CAMERA, LIGHT};
 
 #[path = "common/gltf_builder.rs"]
 mod gltf_builder;
@@ -17,55 +16,6 @@ use gltf_builder::*;
 // Helpers
 // ---------------------------------------------------------------------------------------
 
-/// A fresh directory under the system's temp dir, removed when dropped.
-struct TestDir(PathBuf);
-
-impl TestDir {
-    fn new(tag: &str) -> Self {
-        static COUNTER: AtomicUsize = AtomicUsize::new(0);
-        let n = COUNTER.fetch_add(1, Ordering::Relaxed);
-        let dir = std::env::temp_dir().join(format!(
-            "igi-scene-hostile-{}-{tag}-{n}",
-            std::process::id()
-        ));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).expect("create test dir");
-        TestDir(dir)
-    }
-
-    fn path(&self, name: &str) -> PathBuf {
-        self.0.join(name)
-    }
-
-    fn write(&self, name: &str, contents: impl AsRef<[u8]>) -> PathBuf {
-        let p = self.path(name);
-        std::fs::write(&p, contents).expect("write test file");
-        p
-    }
-
-    /// Writes `scene.toml` and loads it.
-    fn load(&self, toml: &str) -> Result<Scene, SceneError> {
-        load_scene(&self.write("scene.toml", toml))
-    }
-}
-
-impl Drop for TestDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
-
-const CAMERA: &str = "[camera]
-eye = [0.0, 0.0, 5.0]
-target = [0.0, 0.0, 0.0]
-fov_y_deg = 40.0
-";
-
-const LIGHT: &str = "[[point_light]]
-position = [0.0, 0.0, 3.0]
-intensity = [1.0, 1.0, 1.0]
-";
-
 /// A scene with the test camera and light, one `[[mesh]]` per path, and `extra` TOML.
 fn scene_toml(paths: &[&str], extra: &str) -> String {
     let meshes: String = paths
@@ -73,27 +23,6 @@ fn scene_toml(paths: &[&str], extra: &str) -> String {
         .map(|p| format!("[[mesh]]\npath = \"{p}\"\n"))
         .collect();
     format!("{CAMERA}\n{LIGHT}\n{meshes}\n{extra}")
-}
-
-/// The error's message; checks that it is one line and contains `file` and `needles`.
-fn expect_err(r: Result<Scene, SceneError>, file: &str, needles: &[&str]) -> String {
-    let msg = match r {
-        Ok(s) => panic!(
-            "expected an error, the scene loaded ({} triangles)",
-            s.triangles.len()
-        ),
-        Err(e) => e.to_string(),
-    };
-    eprintln!("message: {}", &msg[..msg.len().min(2000)]);
-    assert!(
-        !msg.contains('\n') && !msg.contains('\r'),
-        "message is not one line"
-    );
-    assert!(msg.contains(file), "message does not name {file}: {msg}");
-    for n in needles {
-        assert!(msg.contains(n), "message lacks {n:?}: {msg}");
-    }
-    msg
 }
 
 // ---------------------------------------------------------------------------------------

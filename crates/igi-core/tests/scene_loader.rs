@@ -5,9 +5,11 @@
 //! (`shared/scenes/...`) are used when present and skipped, with a message, when not.
 //! Every error test checks that the message is one line and names the file at fault.
 
+#[path = "common/test_dir.rs"]
+mod test_dir;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
+use test_dir::{expect_err, TestDir, LIGHT};
 
 use igi_core::scene::builtin::{builtin_scene, BUILTIN_NAMES};
 use igi_core::scene::loader::{load_scene, load_scene_str, SceneError, DEFAULT_FILM};
@@ -18,52 +20,11 @@ use igi_core::Vec3;
 // Helpers
 // ---------------------------------------------------------------------------------------
 
-/// A fresh directory under the system's temp dir, removed when dropped.
-struct TestDir(PathBuf);
-
-impl TestDir {
-    fn new(tag: &str) -> Self {
-        static COUNTER: AtomicUsize = AtomicUsize::new(0);
-        let n = COUNTER.fetch_add(1, Ordering::Relaxed);
-        let dir =
-            std::env::temp_dir().join(format!("igi-scene-loader-{}-{tag}-{n}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).expect("create test dir");
-        TestDir(dir)
-    }
-
-    fn path(&self, name: &str) -> PathBuf {
-        self.0.join(name)
-    }
-
-    fn write(&self, name: &str, contents: impl AsRef<[u8]>) -> PathBuf {
-        let p = self.path(name);
-        std::fs::write(&p, contents).expect("write test file");
-        p
-    }
-
-    /// Writes `scene.toml` and loads it.
-    fn load(&self, toml: &str) -> Result<Scene, SceneError> {
-        load_scene(&self.write("scene.toml", toml))
-    }
-}
-
-impl Drop for TestDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
-
 const CAMERA: &str = "[camera]
 eye = [0.0, 0.0, 5.0]
 target = [0.0, 0.0, 0.0]
 up = [0.0, 1.0, 0.0]
 fov_y_deg = 40.0
-";
-
-const LIGHT: &str = "[[point_light]]
-position = [0.0, 0.0, 3.0]
-intensity = [1.0, 1.0, 1.0]
 ";
 
 /// A `[[mesh]]` table.
@@ -91,27 +52,6 @@ fn load_obj(tag: &str, obj: &str, extra: &str) -> Result<Scene, SceneError> {
 /// `[materials.NAME]` with a grey diffuse albedo.
 fn grey(name: &str) -> String {
     format!("[materials.{name}]\ndiffuse = [0.5, 0.5, 0.5]\n")
-}
-
-/// The error's message; checks that it is one line and contains `file` and `needles`.
-fn expect_err(r: Result<Scene, SceneError>, file: &str, needles: &[&str]) -> String {
-    let msg = match r {
-        Ok(s) => panic!(
-            "expected an error, the scene loaded ({} triangles)",
-            s.triangles.len()
-        ),
-        Err(e) => e.to_string(),
-    };
-    eprintln!("message: {msg}");
-    assert!(
-        !msg.contains('\n') && !msg.contains('\r'),
-        "message is not one line: {msg:?}"
-    );
-    assert!(msg.contains(file), "message does not name {file}: {msg}");
-    for n in needles {
-        assert!(msg.contains(n), "message lacks {n:?}: {msg}");
-    }
-    msg
 }
 
 /// The 1-based line of `text` that contains `needle`.
