@@ -622,3 +622,57 @@ fn a_small_scene_far_from_the_origin_is_refused_and_a_far_one_near_it_loads() {
         assert_eq!(s.triangles.len(), 2, "{size}");
     }
 }
+
+// ---------------------------------------------------------------------------------------
+// Required extensions igi does not read are named
+// ---------------------------------------------------------------------------------------
+
+#[test]
+fn required_extensions_igi_cannot_read_are_named() {
+    let dir = TestDir::new("required");
+    // A Draco file as exporters write it: accessors without buffer views, the data in
+    // the primitive's extension. The validation alone would say "missing data" of them.
+    let file = |required: &[&str]| {
+        let names = required
+            .iter()
+            .map(|e| format!("\"{e}\""))
+            .collect::<Vec<_>>()
+            .join(",");
+        format!(
+            r#"{{"asset":{{"version":"2.0"}},"extensionsUsed":[{names}],"extensionsRequired":[{names}],
+"scene":0,"scenes":[{{"nodes":[0]}}],"nodes":[{{"mesh":0}}],
+"meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}},"indices":1,"extensions":{{"KHR_draco_mesh_compression":{{"bufferView":0,"attributes":{{"POSITION":0}}}}}}}}]}}],
+"accessors":[{{"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}},{{"componentType":5123,"count":3,"type":"SCALAR"}}],
+"bufferViews":[{{"buffer":0,"byteLength":4}}],"buffers":[{{"byteLength":4,"uri":"data:application/octet-stream;base64,AAAAAA=="}}]}}"#
+        )
+    };
+    let toml = scene_toml(&["m.gltf"], "[materials.x]\ndiffuse = [0.5, 0.5, 0.5]\n");
+    dir.write("m.gltf", file(&["KHR_draco_mesh_compression"]));
+    let msg = expect_err(
+        dir.load(&toml),
+        "m.gltf",
+        &[
+            "requires (extensionsRequired) the glTF extension KHR_draco_mesh_compression",
+            "Draco",
+        ],
+    );
+    assert!(!msg.contains("missing data"), "{msg}");
+    // Several at once, in one line, an unknown one by its name alone.
+    dir.write(
+        "m.gltf",
+        file(&[
+            "KHR_texture_basisu",
+            "EXT_meshopt_compression",
+            "VENDOR_thing",
+        ]),
+    );
+    expect_err(
+        dir.load(&toml),
+        "m.gltf",
+        &[
+            "extensions KHR_texture_basisu (KTX2",
+            "EXT_meshopt_compression (meshoptimizer",
+            "VENDOR_thing, which igi does not read",
+        ],
+    );
+}

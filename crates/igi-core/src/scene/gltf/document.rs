@@ -12,6 +12,7 @@ use ::gltf::Semantic;
 use super::accessors::{ReadStats, Reader, Shared};
 use super::messages::{document_error, invalid, parse};
 use super::GltfMesh;
+use crate::scene::error::quote;
 use crate::scene::loader::{SceneError, TriangleBudget};
 
 /// Decodes `%XX` escapes of a relative URI. `None` when the result is not UTF-8 (the gltf
@@ -79,6 +80,9 @@ pub(super) fn document(bytes: &[u8], file: &str) -> Result<::gltf::Gltf, SceneEr
     };
     // `extras` may be any JSON value (the gltf crate's `extras` feature keeps it raw).
     let root = from_slice::<Root>(&json).map_err(|e| error(::gltf::Error::Deserialize(e)))?;
+    // Before the validation, whose complaints about what such an extension replaces
+    // (accessors without data, images without a source) would not name it.
+    required_extensions(&root, file)?;
     // gltf 1.4's validation reads `accessors[POSITION]` with `[]`: check that index first.
     for (m, mesh) in root.meshes.iter().enumerate() {
         for (p, prim) in mesh.primitives.iter().enumerate() {
@@ -100,6 +104,49 @@ pub(super) fn document(bytes: &[u8], file: &str) -> Result<::gltf::Gltf, SceneEr
     let document =
         ::gltf::Document::from_json(root).map_err(|e| document_error(e, file, is_glb))?;
     Ok(::gltf::Gltf { document, blob })
+}
+
+/// Error naming every extension the file requires (`extensionsRequired`) that igi does
+/// not read, with what it is for the common ones.
+fn required_extensions(root: &Root, file: &str) -> Result<(), SceneError> {
+    let missing: Vec<String> = root
+        .extensions_required
+        .iter()
+        .filter(|e| !::gltf::json::extensions::ENABLED_EXTENSIONS.contains(&e.as_str()))
+        .map(|e| match unread_extension(e) {
+            Some(what) => format!("{} ({what})", quote(e)),
+            None => quote(e),
+        })
+        .collect();
+    if missing.is_empty() {
+        return Ok(());
+    }
+    let (s, them) = if missing.len() == 1 {
+        ("", "it")
+    } else {
+        ("s", "them")
+    };
+    Err(parse(
+        file,
+        format!(
+            "the file requires (extensionsRequired) the glTF extension{s} {}, which igi does not read; export the model without {them}",
+            missing.join(", ")
+        ),
+    ))
+}
+
+/// What a required extension igi does not read is, for its error.
+fn unread_extension(name: &str) -> Option<&'static str> {
+    Some(match name {
+        "KHR_draco_mesh_compression" => "Draco-compressed meshes",
+        "EXT_meshopt_compression" => "meshoptimizer-compressed buffers",
+        "KHR_mesh_quantization" => "quantized vertex attributes",
+        "KHR_texture_basisu" => "KTX2 / Basis Universal textures",
+        "EXT_texture_webp" => "WebP textures",
+        "KHR_texture_transform" => "texture coordinate transforms",
+        "KHR_materials_unlit" => "unlit materials",
+        _ => return None,
+    })
 }
 
 /// Reads one glTF file (see [`super::load_gltf_bytes`]) whose triangles must fit in
