@@ -767,3 +767,44 @@ fn corrupted_files_give_errors_not_panics() {
     eprintln!("{ok} corrupted files loaded, {err} refused");
     assert!(err > 0);
 }
+
+// ---------------------------------------------------------------------------------------
+// What a file holds that igi does not render is said
+// ---------------------------------------------------------------------------------------
+
+/// The Khronos samples of `../shared/gltf-samples` list, in `GltfMesh::ignored`, what
+/// their upstream READMEs say they exercise and igi does not render.
+#[test]
+fn features_igi_does_not_render_are_listed() {
+    let samples = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/gltf-samples");
+    if !samples.is_dir() {
+        eprintln!("skipped: {} is absent", samples.display());
+        return;
+    }
+    let ignored = |name: &str| {
+        let glb = samples
+            .join(name)
+            .join("glTF-Binary")
+            .join(format!("{name}.glb"));
+        load_gltf(&glb)
+            .unwrap_or_else(|e| panic!("{name}: {e}"))
+            .ignored
+            .join(", ")
+    };
+    let cases = [
+        ("VertexColorTest", "COLOR_0 vertex colours"),
+        ("SimpleInstancing", "extension EXT_mesh_gpu_instancing"),
+        ("AlphaBlendModeTest", "alpha modes MASK and BLEND"),
+        ("MultiUVTest", "a second texture coordinate set"),
+        ("NormalTangentTest", "normal maps"),
+    ];
+    for (name, what) in cases {
+        let list = ignored(name);
+        assert!(list.contains(what), "{name}: {list:?}");
+    }
+    assert_eq!(
+        ignored("Box"),
+        "",
+        "the plain box holds nothing igi ignores"
+    );
+}

@@ -104,6 +104,9 @@ pub struct GltfMesh {
     pub lights: Vec<PointLight>,
     /// Files read besides the glTF file itself: external buffers and images.
     pub files: Vec<PathBuf>,
+    /// What the file holds that igi does not render, one entry a feature (said in one
+    /// warning, "ignored: ..."), e.g. "COLOR_0 vertex colours (1 primitive)".
+    pub ignored: Vec<String>,
 }
 
 /// Whether `path` names a glTF file: it ends in `.gltf` or `.glb`, in any case.

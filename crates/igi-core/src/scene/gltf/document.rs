@@ -184,7 +184,97 @@ pub(super) fn read(
     };
     r.scene(&document, &scene)?;
     r.warn.log(file);
+    r.out.ignored = ignored_features(&document);
+    if !r.out.ignored.is_empty() {
+        log::warn!("{file}: ignored: {}", r.out.ignored.join(", "));
+    }
     Ok((r.out, r.stats))
+}
+
+/// What `doc` holds that igi does not render (see [`GltfMesh::ignored`]), each with how
+/// many of its parts use it. Base colour textures are averaged, emission, skins, morph
+/// targets and spot or directional lights have warnings of their own, so none is here.
+pub(super) fn ignored_features(doc: &::gltf::Document) -> Vec<String> {
+    let json = doc.as_json();
+    let mut out = Vec::new();
+    let mut say = |n: usize, what: &str, of: &str| {
+        if n > 0 {
+            let s = if n == 1 { "" } else { "s" };
+            out.push(format!("{what} ({n} {of}{s})"));
+        }
+    };
+    // Extensions igi reads (lights, and the strength of emission it warns of).
+    const READ: [&str; 2] = ["KHR_lights_punctual", "KHR_materials_emissive_strength"];
+    let prims = || doc.meshes().flat_map(|m| m.primitives());
+    let with_attribute = |name: &str| {
+        prims()
+            .filter(|p| p.attributes().any(|(s, _)| s.to_string() == name))
+            .count()
+    };
+    say(
+        with_attribute("COLOR_0"),
+        "COLOR_0 vertex colours",
+        "primitive",
+    );
+    say(
+        with_attribute("TEXCOORD_1"),
+        "a second texture coordinate set",
+        "primitive",
+    );
+    let materials = || doc.materials();
+    say(
+        materials().filter(|m| m.normal_texture().is_some()).count(),
+        "normal maps",
+        "material",
+    );
+    say(
+        materials()
+            .filter(|m| {
+                m.pbr_metallic_roughness()
+                    .metallic_roughness_texture()
+                    .is_some()
+            })
+            .count(),
+        "metallic-roughness textures",
+        "material",
+    );
+    say(
+        materials()
+            .filter(|m| m.occlusion_texture().is_some())
+            .count(),
+        "occlusion textures",
+        "material",
+    );
+    say(
+        materials()
+            .filter(|m| m.alpha_mode() != ::gltf::material::AlphaMode::Opaque)
+            .count(),
+        "alpha modes MASK and BLEND (drawn opaque)",
+        "material",
+    );
+    say(
+        materials()
+            .filter(|m| {
+                m.pbr_metallic_roughness()
+                    .base_color_texture()
+                    .is_some_and(|t| t.tex_coord() != 0)
+            })
+            .count(),
+        "base colour textures on texture coordinate set 1",
+        "material",
+    );
+    say(json.animations.len(), "animations", "animation");
+    say(
+        json.cameras.len(),
+        "cameras (the scene file's [camera] is used)",
+        "camera",
+    );
+    for e in &json.extensions_used {
+        if !READ.contains(&e.as_str()) {
+            out.push(format!("extension {}", quote(e)));
+        }
+    }
+    out
 }
 
 /// Images that `Image::source()` of gltf 1.4 would `unwrap()` a `None` of: it assumes a
