@@ -139,11 +139,14 @@ fn random_rooms_render_alike_at_every_scale() {
             let s = settings(a.clone());
             let unit = common::render(&ctx, &room, &s).image;
             assert!(unit.mean()[0] > 1e-3, "seed {seed}: the unit room is dark");
-            // Scaled down by a power of two, the scene is traced scaled back up: the same
-            // bits.
-            let exact = common::render(&ctx, &scaled(&room, 2f64.powi(-30)), &s).image;
-            assert_eq!(exact.data, unit.data, "seed {seed} {name}: 2^-30");
-            for k in [1e-6, 1e-3, 0.1, 10.0, 1e3, 1e6, 1e9, 1e12, 1e13, 1e16] {
+            // Scaled by a power of two beyond the range traced unscaled, the scene is
+            // traced at the range's nearer octave: the same bits as the scene made that
+            // size (2^-4 and 2^19 of the unit room, whose largest coordinate is 1).
+            for (far, near) in [(-30, -4), (40, 19)] {
+                let at = |k: i32| common::render(&ctx, &scaled(&room, 2f64.powi(k)), &s).image;
+                assert_eq!(at(far).data, at(near).data, "seed {seed} {name}: 2^{far}");
+            }
+            for k in [1e-6, 1e-3, 0.07, 0.1, 10.0, 1e3, 1e6, 1e9, 1e12, 1e13, 1e16] {
                 let image = common::render(&ctx, &scaled(&room, k), &s).image;
                 let e = rel_mse(&image, &unit).unwrap();
                 let off = share_off(&image, &unit);
