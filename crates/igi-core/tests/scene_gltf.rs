@@ -793,7 +793,6 @@ fn features_igi_does_not_render_are_listed() {
     };
     let cases = [
         ("VertexColorTest", "COLOR_0 vertex colours"),
-        ("SimpleInstancing", "extension EXT_mesh_gpu_instancing"),
         ("AlphaBlendModeTest", "alpha modes MASK and BLEND"),
         ("MultiUVTest", "a second texture coordinate set"),
         ("NormalTangentTest", "normal maps"),
@@ -807,4 +806,31 @@ fn features_igi_does_not_render_are_listed() {
         "",
         "the plain box holds nothing igi ignores"
     );
+}
+
+/// SimpleInstancing (EXT_mesh_gpu_instancing): 125 boxes, each where its instance's
+/// translation, rotation and scale put it, under the node's transform.
+#[test]
+fn gpu_instancing_places_every_instance() {
+    let glb = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared/gltf-samples/SimpleInstancing/glTF-Binary/SimpleInstancing.glb");
+    if !glb.is_file() {
+        eprintln!("skipped: {} is absent", glb.display());
+        return;
+    }
+    let mesh = load_gltf(&glb).unwrap();
+    assert_eq!(mesh.triangles.len(), 125 * 12, "125 boxes of 12 triangles");
+    assert!(!mesh.ignored.join(", ").contains("EXT_mesh_gpu_instancing"));
+    // The boxes lie apart: their centroids (12 triangles each, in instance order) are
+    // 125 distinct points.
+    let centres: Vec<Vec3> = mesh
+        .triangles
+        .chunks(12)
+        .map(|c| c.iter().flat_map(|t| t.v).sum::<Vec3>() / 36.0)
+        .collect();
+    for (i, a) in centres.iter().enumerate() {
+        for b in &centres[i + 1..] {
+            assert!(a.distance(*b) > 1e-3, "two instances at {a}");
+        }
+    }
 }

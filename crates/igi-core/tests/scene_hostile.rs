@@ -446,7 +446,7 @@ fn node_trees_beyond_the_triangle_limit_are_refused_before_they_are_made() {
                 nodes * prims * tris
             ),
             &format!(
-                "mesh 0 placed by {nodes} nodes, {} triangles each",
+                "mesh 0 placed {nodes} times by nodes and instances, {} triangles each",
                 prims * tris
             ),
             &format!("more than the {MAX_TRIANGLES} triangles a scene may have"),
@@ -675,4 +675,31 @@ fn required_extensions_igi_cannot_read_are_named() {
             "VENDOR_thing, which igi does not read",
         ],
     );
+}
+
+/// EXT_mesh_gpu_instancing counts toward the triangle limit before any instance is read:
+/// a few hundred bytes that place a quad 2^25 times are refused.
+#[test]
+fn instances_beyond_the_triangle_limit_are_refused_before_they_are_made() {
+    let dir = TestDir::new("instances");
+    let quad = r#"{"asset":{"version":"2.0"},"extensionsUsed":["EXT_mesh_gpu_instancing"],
+"scene":0,"scenes":[{"nodes":[0]}],
+"nodes":[{"mesh":0,"extensions":{"EXT_mesh_gpu_instancing":{"attributes":{"TRANSLATION":2}}}}],
+"meshes":[{"primitives":[{"attributes":{"POSITION":0},"indices":1}]}],
+"buffers":[{"byteLength":60,"uri":"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAACAPwAAgD8AAAAAAAAAAAAAgD8AAAAAAAABAAIAAAACAAMA"}],
+"bufferViews":[{"buffer":0,"byteOffset":0,"byteLength":48},{"buffer":0,"byteOffset":48,"byteLength":12}],
+"accessors":[{"bufferView":0,"componentType":5126,"count":4,"type":"VEC3","min":[0,0,0],"max":[1,1,0]},
+{"bufferView":1,"componentType":5123,"count":6,"type":"SCALAR"},
+{"bufferView":0,"componentType":5126,"count":COUNT,"type":"VEC3"}]}"#;
+    let toml = scene_toml(&["m.gltf"], "[materials.x]\ndiffuse = [0.5, 0.5, 0.5]\n");
+    dir.write("m.gltf", quad.replace("COUNT", "33554432"));
+    expect_err(
+        dir.load(&toml),
+        "m.gltf",
+        &["would make 67108864 triangles", "placed 33554432 times"],
+    );
+    // Three instances (at the quad's first three vertices) load.
+    dir.write("m.gltf", quad.replace("COUNT", "3"));
+    let s = dir.load(&toml).unwrap();
+    assert_eq!(s.triangles.len(), 6);
 }

@@ -36,6 +36,7 @@
 
 mod accessors;
 mod document;
+mod instancing;
 mod materials;
 mod messages;
 mod nodes;

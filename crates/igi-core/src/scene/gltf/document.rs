@@ -204,7 +204,11 @@ pub(super) fn ignored_features(doc: &::gltf::Document) -> Vec<String> {
         }
     };
     // Extensions igi reads (lights, and the strength of emission it warns of).
-    const READ: [&str; 2] = ["KHR_lights_punctual", "KHR_materials_emissive_strength"];
+    const READ: [&str; 3] = [
+        "KHR_lights_punctual",
+        "KHR_materials_emissive_strength",
+        "EXT_mesh_gpu_instancing",
+    ];
     let prims = || doc.meshes().flat_map(|m| m.primitives());
     let with_attribute = |name: &str| {
         prims()

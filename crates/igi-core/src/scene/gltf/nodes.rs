@@ -42,9 +42,16 @@ impl Reader {
                 if node.skin().is_some() || mesh.primitives().any(|p| p.morph_targets().len() > 0) {
                     self.warn.skinned_or_morphed += 1;
                 }
+                // EXT_mesh_gpu_instancing: the mesh once per instance, else once.
+                let worlds = match self.instances(doc, node)? {
+                    Some(instances) => instances.iter().map(|m| *world * *m).collect(),
+                    None => vec![*world],
+                };
                 for prim in mesh.primitives() {
                     if let Some(prepared) = self.prepare(&mesh, &prim)? {
-                        self.place(&prepared, world);
+                        for world in &worlds {
+                            self.place(&prepared, world);
+                        }
                     }
                 }
             }
@@ -114,7 +121,10 @@ impl Reader {
         // Per mesh: its triangles, and how many nodes place it.
         let mut per_mesh: Vec<(usize, usize)> = vec![(0, 0); doc.meshes().len()];
         let mut total = 0usize;
-        for mesh in placed.iter().filter_map(|(node, _)| node.mesh()) {
+        for node in placed.iter().map(|(node, _)| node) {
+            let Some(mesh) = node.mesh() else {
+                continue;
+            };
             let Some(entry) = per_mesh.get_mut(mesh.index()) else {
                 continue;
             };
@@ -124,8 +134,10 @@ impl Reader {
                     .map(|p| primitive_triangles(&p))
                     .fold(0, usize::saturating_add);
             }
-            entry.1 += 1;
-            total = total.saturating_add(entry.0);
+            // A node with EXT_mesh_gpu_instancing places it once per instance.
+            let copies = super::instancing::copies(&self.file, doc, node)?;
+            entry.1 = entry.1.saturating_add(copies);
+            total = total.saturating_add(entry.0.saturating_mul(copies));
         }
         self.budget.check(total, &self.file, || {
             let most = per_mesh
@@ -134,7 +146,7 @@ impl Reader {
                 .max_by_key(|(_, (t, n))| t.saturating_mul(*n));
             let detail = match most.and_then(|(m, &(t, n))| Some((doc.meshes().nth(m)?, t, n))) {
                 Some((mesh, t, n)) if n > 1 => format!(
-                    " ({} placed by {n} nodes, {t} triangles each)",
+                    " ({} placed {n} times by nodes and instances, {t} triangles each)",
                     mesh_label(&mesh)
                 ),
                 _ => String::new(),
