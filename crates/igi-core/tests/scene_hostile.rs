@@ -396,14 +396,17 @@ fn rotations_far_from_unit_length_are_refused_and_near_ones_normalised() {
             ],
         );
     }
-    // A rotation that is not finite is refused as before.
+    // A rotation that is not finite is refused as before: by the node check, or by the
+    // JSON reader where the workspace's serde_json features make it refuse a number
+    // past the f32 range (as `cargo test --workspace` builds it).
     let mut g = quad(None);
     g.node(r#""mesh": 0, "rotation": [0.0, 0.0, 0.0, 1e39]"#);
     dir.write("inf.gltf", g.gltf());
-    expect_err(
-        dir.load(&scene_toml(&["inf.gltf"], "")),
-        "inf.gltf",
-        &["node 0", "not finite"],
+    let msg = expect_err(dir.load(&scene_toml(&["inf.gltf"], "")), "inf.gltf", &[]);
+    assert!(
+        (msg.contains("node 0") && msg.contains("not finite"))
+            || msg.contains("number out of range"),
+        "{msg}"
     );
 }
 
