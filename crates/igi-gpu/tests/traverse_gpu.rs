@@ -360,7 +360,7 @@ fn run_kernel(ctx: &GpuContext, bvh: &Bvh, rays: &[(TestRay, Kind)]) -> Vec<Test
         source: wgpu::ShaderSource::Wgsl(src.into()),
     });
     // Auto layout: bind group 0 gets only the scene bindings the kernel uses
-    // (bvh_nodes, tri_rows).
+    // (bvh_nodes, tri_rows, and ray_counters, where walks count being cut short).
     let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
         label: Some("traverse test"),
         layout: None,
@@ -397,12 +397,12 @@ fn run_kernel(ctx: &GpuContext, bvh: &Bvh, rays: &[(TestRay, Kind)]) -> Vec<Test
         bytemuck::cast_slice(&vec![TestResult::zeroed(); rays.len()]),
         wgpu::BufferUsages::COPY_SRC,
     );
-    let bind = |index: u32, buffers: &[&wgpu::Buffer]| {
+    let counters = storage("ray_counters", &[0u8; 32], wgpu::BufferUsages::empty());
+    let bind = |index: u32, buffers: &[(u32, &wgpu::Buffer)]| {
         let entries: Vec<wgpu::BindGroupEntry> = buffers
             .iter()
-            .enumerate()
-            .map(|(i, b)| wgpu::BindGroupEntry {
-                binding: i as u32,
+            .map(|&(binding, b)| wgpu::BindGroupEntry {
+                binding,
                 resource: b.as_entire_binding(),
             })
             .collect();
@@ -412,8 +412,8 @@ fn run_kernel(ctx: &GpuContext, bvh: &Bvh, rays: &[(TestRay, Kind)]) -> Vec<Test
             entries: &entries,
         })
     };
-    let scene_group = bind(0, &[&nodes, &rows]);
-    let io_group = bind(1, &[&ray_buf, &out]);
+    let scene_group = bind(0, &[(0, &nodes), (1, &rows), (5, &counters)]);
+    let io_group = bind(1, &[(0, &ray_buf), (1, &out)]);
     let mut encoder =
         device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
     {
