@@ -121,8 +121,8 @@ impl Image {
         }
         check_exr_sizes(bytes).map_err(err)?;
         // On this thread (not the decoder's thread pool, where a panic aborts the
-        // process) and inside catch_unwind: the decoder's B44 code was found to overflow
-        // an integer on damaged data, which panics where overflow checks are on.
+        // process) and inside catch_unwind: the decoder's B44 code overflows an integer
+        // on some damaged data, which panics where overflow checks are on.
         let decode = || {
             exr::prelude::read()
                 .no_deep_data()
@@ -189,10 +189,10 @@ impl Image {
         encoder.set_color(png::ColorType::Rgb);
         encoder.set_depth(png::BitDepth::Eight);
         encoder.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
-        // fdeflate's fast mode: on the path-traced references at 512 x 512 and
-        // 800 x 600, 2-4 ms against 85-173 ms for the default (Balanced), for files
-        // 9-25% larger; the default took longer than an 800 x 600 frame's GPU work
-        // in `igi render` and about 8 s of a full `igi bench` table.
+        // fdeflate's fast mode: tens of times faster than the default (Balanced) for
+        // files up to a quarter larger; the default took longer than a frame's GPU work
+        // in `igi render` and seconds of a full `igi bench` table (figures in the lab
+        // log, BENCHMARKS-history.md).
         encoder.set_compression(png::Compression::Fast);
         let mut writer = encoder.write_header().map_err(|e| e.to_string())?;
         writer.write_image_data(&bytes).map_err(|e| e.to_string())?;

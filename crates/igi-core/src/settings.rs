@@ -420,7 +420,8 @@ impl RenderSettings {
         self.accelerations.validate()
     }
 
-    fn validate_size(&self) -> Result<(), SettingsError> {
+    /// The image's size: each side at least 1 and at most [`MAX_IMAGE_SIDE`].
+    pub fn validate_size(&self) -> Result<(), SettingsError> {
         if self.width == 0 || self.height == 0 {
             return Err(SettingsError::ImageSize {
                 width: self.width,

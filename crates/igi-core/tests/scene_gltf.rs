@@ -185,21 +185,8 @@ fn strips_fans_points_and_non_indexed_primitives() {
 #[test]
 fn sparse_positions_without_a_buffer_view() {
     let dir = TestDir::new("sparse");
-    let mut g = Gltf::default();
     // Zeros, with vertices 1 to 3 replaced by the quad's: the quad again.
-    let idx: Vec<u8> = [1u16, 2, 3].iter().flat_map(|x| x.to_le_bytes()).collect();
-    let vals: Vec<u8> = QUAD[1..]
-        .iter()
-        .flatten()
-        .flat_map(|x| x.to_le_bytes())
-        .collect();
-    let (iv, vv) = (g.view(&idx), g.view(&vals));
-    let p = g.accessor(format!(
-        r#"{{"componentType": 5126, "count": 4, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0], "sparse": {{"count": 3, "indices": {{"bufferView": {iv}, "componentType": 5123}}, "values": {{"bufferView": {vv}}}}}}}"#
-    ));
-    let i = g.indices(&QUAD_INDICES);
-    g.mesh(&[primitive(p, Some(i), "")]);
-    g.node(r#""mesh": 0"#);
+    let g = sparse_quad(&[1, 2, 3], 5123);
     dir.write("sparse.gltf", g.gltf());
     let s = dir.load(&scene_toml("sparse.gltf", LIGHT)).unwrap();
     let expect: Vec<Vec3> = QUAD_INDICES

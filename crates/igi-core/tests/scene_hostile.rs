@@ -274,33 +274,6 @@ fn extras_of_any_json_type_are_accepted() {
 // Bad files that were accepted
 // ---------------------------------------------------------------------------------------
 
-/// The quad's positions as a sparse accessor over zeros, vertices `indices` replaced by
-/// `QUAD[1..]` (`indices` of u8, u16 or u32 as `component` 5121, 5123 or 5125 says).
-fn sparse_quad(indices: &[u32], component: u32) -> Gltf {
-    let mut g = Gltf::default();
-    let idx: Vec<u8> = match component {
-        5121 => indices.iter().map(|&x| x as u8).collect(),
-        5123 => indices
-            .iter()
-            .flat_map(|&x| (x as u16).to_le_bytes())
-            .collect(),
-        _ => indices.iter().flat_map(|x| x.to_le_bytes()).collect(),
-    };
-    let vals: Vec<u8> = QUAD[1..]
-        .iter()
-        .flatten()
-        .flat_map(|x| x.to_le_bytes())
-        .collect();
-    let (iv, vv) = (g.view(&idx), g.view(&vals));
-    let p = g.accessor(format!(
-        r#"{{"componentType": 5126, "count": 4, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0], "sparse": {{"count": 3, "indices": {{"bufferView": {iv}, "componentType": {component}}}, "values": {{"bufferView": {vv}}}}}}}"#
-    ));
-    let i = g.indices(&QUAD_INDICES);
-    g.mesh(&[primitive(p, Some(i), "")]);
-    g.node(r#""mesh": 0"#);
-    g
-}
-
 #[test]
 fn sparse_indices_out_of_order_or_range_are_refused() {
     let dir = TestDir::new("sparse");

@@ -252,14 +252,16 @@ impl OutputFiles {
             }
         }
         let mut partial = partial_files();
-        for r in &mut self.files {
+        // Each output leaves the list once renamed: what is left when a rename fails is
+        // what Drop removes.
+        while !self.files.is_empty() {
+            let r = &self.files[0];
             std::fs::rename(&r.tmp, &r.target).map_err(|e| ImageError::Write {
                 path: r.path.clone(),
                 reason: e.to_string(),
             })?;
             partial.retain(|p| p != &r.tmp);
-            r.written = false;
-            r.tmp = PathBuf::new();
+            self.files.remove(0);
         }
         Ok(())
     }
@@ -270,10 +272,8 @@ impl Drop for OutputFiles {
     fn drop(&mut self) {
         let mut partial = partial_files();
         for r in &self.files {
-            if !r.tmp.as_os_str().is_empty() {
-                let _ = std::fs::remove_file(&r.tmp);
-                partial.retain(|p| p != &r.tmp);
-            }
+            let _ = std::fs::remove_file(&r.tmp);
+            partial.retain(|p| p != &r.tmp);
         }
     }
 }

@@ -10,6 +10,7 @@ mod params;
 pub(crate) mod recorder;
 pub mod resources;
 mod shadow_rays;
+mod walks;
 
 pub(crate) use listing::FrameShape;
 pub use listing::{filter_chain, low_resolution};
@@ -149,6 +150,8 @@ pub struct Renderer {
     counting: bool,
     /// The parameters of the last submitted frame.
     last_params: Option<FrameParams>,
+    /// Where `check_walks` gathers the counts of walks cut short (software adapters).
+    cut_walks: Option<wgpu::Buffer>,
 }
 
 fn permutation_buffer(ctx: &GpuContext, seed: u32) -> wgpu::Buffer {
@@ -238,6 +241,7 @@ impl Renderer {
             path_cache: None,
             counting: false,
             last_params: None,
+            cut_walks: None,
             software: ctx.is_software(),
             has_mirrors: scene.materials.iter().any(|m| m.mirror.max_element() > 0.0),
         };
@@ -395,12 +399,12 @@ impl Renderer {
     }
 
     fn check_size(ctx: &GpuContext, settings: &RenderSettings) -> Result<(), GpuError> {
+        // igi-core's checks of the size (at least 1, at most MAX_IMAGE_SIDE a side),
+        // then this adapter's limit.
+        settings
+            .validate_size()
+            .map_err(|e| GpuError::Limit(e.to_string()))?;
         let (w, h) = (settings.width, settings.height);
-        if w == 0 || h == 0 {
-            return Err(GpuError::Limit(format!(
-                "image size {w}x{h}: both must be at least 1"
-            )));
-        }
         let bytes = w as u64 * h as u64 * 16;
         if bytes > ctx.max_storage_binding() {
             return Err(GpuError::Limit(format!(
@@ -528,28 +532,6 @@ impl Renderer {
             stages,
             frame_ms,
         })
-    }
-
-    /// Error where a software adapter cut BVH walks of the frames so far short (its loop
-    /// limit, see traverse.wgsl's LOOP_CUTS_COUNTED): their images would be wrong. No
-    /// work on GPUs, which count nothing there.
-    pub fn check_walks(&self, ctx: &GpuContext) -> Result<(), GpuError> {
-        if !self.software {
-            return Ok(());
-        }
-        let mut cut = 0u64;
-        for counters in
-            std::iter::once(&self.scene.ray_counters).chain(&self.scene.spare_ray_counters)
-        {
-            let counts: Vec<u32> = ctx.read_buffer(counters)?;
-            cut += counts[CUT_WALKS] as u64;
-        }
-        if cut == 0 {
-            return Ok(());
-        }
-        Err(GpuError::Limit(format!(
-            "the software adapter ended {cut} ray traversals before they were done (llvmpipe stops a shader after 65,535 loop iterations, and this scene's BVH needs more: many overlapping triangles), so the image would be wrong; render on a GPU, or with fewer overlapping triangles"
-        )))
     }
 
     /// GPU times of the last submitted frame's stages `names` (as [`Renderer::submit_frame`]
@@ -748,22 +730,12 @@ fn check_light_power(sum: f32, scale: TraceScale) -> Result<(), GpuError> {
     )))
 }
 
-/// scene.wgsl's counter of walks cut short (`CUT_WALKS`).
-const CUT_WALKS: usize = 7;
-
 /// Reject settings the passes cannot honour, by igi-core's validation (the one the
 /// command, the bench and the viewer run): the accelerations' parameters, and a mirror
 /// depth past [`MAX_MIRROR_DEPTH`]. Counts of zero (VPLs, bounces, frames) are taken as
 /// one here, as the frame always has.
 fn check_settings(settings: &RenderSettings) -> Result<(), GpuError> {
     let refuse = |e: SettingsError| GpuError::Limit(e.to_string());
-    let side = igi_core::settings::MAX_IMAGE_SIDE;
-    if settings.width > side || settings.height > side {
-        return Err(refuse(SettingsError::ImageSide {
-            width: settings.width,
-            height: settings.height,
-        }));
-    }
     if settings.mirror_depth > MAX_MIRROR_DEPTH {
         return Err(refuse(SettingsError::MirrorDepth(settings.mirror_depth)));
     }

@@ -4,10 +4,11 @@
 //! T * R * S, under the node's world matrix.
 
 use ::gltf::accessor::{DataType, Dimensions, Iter};
-use glam::{DQuat, Mat4, Quat, Vec3};
+use glam::{Mat4, Quat, Vec3};
 
 use super::accessors::Reader;
 use super::messages::parse;
+use super::nodes::unit_rotation;
 use super::MAX_ROTATION_LENGTH_ERROR;
 use crate::scene::loader::SceneError;
 
@@ -55,40 +56,43 @@ pub(super) fn copies(
     doc: &::gltf::Document,
     node: &::gltf::Node,
 ) -> Result<usize, SceneError> {
-    let Some(attrs) = attributes(file, node)? else {
-        return Ok(1);
-    };
+    match attributes(file, node)? {
+        Some(attrs) => count(file, doc, node, &attrs),
+        None => Ok(1),
+    }
+}
+
+/// The instances' count: that of the accessors, which must exist and agree (1 where the
+/// extension names none).
+fn count(
+    file: &str,
+    doc: &::gltf::Document,
+    node: &::gltf::Node,
+    attrs: &Attributes,
+) -> Result<usize, SceneError> {
+    let bad = |why: String| parse(file, format!("node {}: {EXTENSION}: {why}", node.index()));
     let mut count = None;
     for index in [attrs.translation, attrs.rotation, attrs.scale]
         .into_iter()
         .flatten()
     {
         let acc = doc.accessors().nth(index).ok_or_else(|| {
-            parse(
-                file,
-                format!(
-                    "node {}: {EXTENSION}: accessor {index} does not exist (the file has {})",
-                    node.index(),
-                    doc.accessors().len()
-                ),
-            )
+            bad(format!(
+                "accessor {index} does not exist (the file has {})",
+                doc.accessors().len()
+            ))
         })?;
         match count {
             None => count = Some(acc.count()),
             Some(n) if n != acc.count() => {
-                return Err(parse(
-                    file,
-                    format!(
-                        "node {}: {EXTENSION}: its accessors have different counts ({n} and {})",
-                        node.index(),
-                        acc.count()
-                    ),
-                ))
+                return Err(bad(format!(
+                    "its accessors have different counts ({n} and {})",
+                    acc.count()
+                )))
             }
             _ => {}
         }
     }
-    // No attribute at all: one instance at the node itself.
     Ok(count.unwrap_or(1))
 }
 
@@ -103,9 +107,9 @@ impl Reader {
         let Some(attrs) = attributes(&self.file, node)? else {
             return Ok(None);
         };
-        let n = copies(&self.file, doc, node)?;
+        let n = count(&self.file, doc, node, &attrs)?;
         let what = |attr: &str| format!("node {} {EXTENSION} {attr}", node.index());
-        let accessor = |i: usize| doc.accessors().nth(i).expect("checked by copies");
+        let accessor = |i: usize| doc.accessors().nth(i).expect("checked by count");
         let translations = match attrs.translation {
             Some(i) => Some(self.vec3s(&accessor(i), &what("TRANSLATION"))?),
             None => None,
@@ -168,19 +172,15 @@ impl Reader {
             .into_iter()
             .enumerate()
             .map(|(k, q)| {
-                let length = DQuat::from_array(q.map(f64::from)).length();
-                if q.iter().all(|c| c.is_finite())
-                    && (length - 1.0).abs() <= f64::from(MAX_ROTATION_LENGTH_ERROR)
-                {
-                    Ok(Quat::from_array(q).normalize())
-                } else {
-                    Err(parse(
-                        &self.file,
-                        format!(
-                            "{what} (accessor {}) element {k}: rotation {q:?} has length {length:.6}, not 1 (a length within {MAX_ROTATION_LENGTH_ERROR} of 1 is normalised)",
-                            acc.index()
-                        ),
-                    ))
+                let bad = |why: String| {
+                    parse(&self.file, format!("{what} (accessor {}) element {k}: rotation {q:?} {why}", acc.index()))
+                };
+                match unit_rotation(q) {
+                    Ok(r) if r.is_finite() => Ok(r),
+                    Ok(_) => Err(bad("is not finite".into())),
+                    Err(length) => Err(bad(format!(
+                        "has length {length:.6}, not 1 (a length within {MAX_ROTATION_LENGTH_ERROR} of 1 is normalised)"
+                    ))),
                 }
             })
             .collect()

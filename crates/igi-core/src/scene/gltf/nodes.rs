@@ -168,26 +168,15 @@ impl Reader {
                 rotation,
                 scale,
             } => {
-                let q = Quat::from_array(rotation);
-                // In f64: the length of any finite f32 quaternion, without overflow.
-                let length = DQuat::from_array(rotation.map(f64::from)).length();
-                let q = if !q.is_finite() {
-                    q
-                } else if (length - 1.0).abs() <= f64::from(MAX_ROTATION_LENGTH_ERROR) {
-                    q.normalize()
-                } else {
-                    return Err(invalid(
+                let q = unit_rotation(rotation).map_err(|length| {
+                    invalid(
                         &self.file,
                         format!(
-                            "node {}: rotation [{}, {}, {}, {}] has length {length:.6}, not 1: glTF node rotations are unit quaternions (a length within {MAX_ROTATION_LENGTH_ERROR} of 1 is normalised)",
+                            "node {}: rotation {rotation:?} has length {length:.6}, not 1: glTF node rotations are unit quaternions (a length within {MAX_ROTATION_LENGTH_ERROR} of 1 is normalised)",
                             node.index(),
-                            q.x,
-                            q.y,
-                            q.z,
-                            q.w
                         ),
-                    ));
-                };
+                    )
+                })?;
                 Ok(Mat4::from_scale_rotation_translation(
                     Vec3::from(scale),
                     q,
@@ -368,6 +357,23 @@ impl Reader {
 
 /// The triangles a primitive makes, from its accessors' declared counts (nothing is
 /// read): what [`triangulate`] would give.
+/// A glTF rotation (x, y, z, w) as a unit quaternion: normalised where its length is
+/// within [`MAX_ROTATION_LENGTH_ERROR`] of 1 (exporters' rounding), else `Err(length)`
+/// (it would shear and scale what it rotates). A rotation that is not finite is returned
+/// as it is, for the callers' checks of their matrices, which name it.
+pub(super) fn unit_rotation(q: [f32; 4]) -> Result<Quat, f64> {
+    let quat = Quat::from_array(q);
+    // In f64: the length of any finite f32 quaternion, without overflow.
+    let length = DQuat::from_array(q.map(f64::from)).length();
+    if !quat.is_finite() {
+        Ok(quat)
+    } else if (length - 1.0).abs() <= f64::from(MAX_ROTATION_LENGTH_ERROR) {
+        Ok(quat.normalize())
+    } else {
+        Err(length)
+    }
+}
+
 fn primitive_triangles(prim: &::gltf::Primitive) -> usize {
     let n = match prim.indices() {
         Some(acc) => acc.count(),
