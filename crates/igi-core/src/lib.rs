@@ -13,6 +13,7 @@ pub mod rays;
 pub mod sampling;
 pub mod scene;
 pub mod settings;
+pub mod texture;
 pub mod trace_scale;
 pub mod vpl;
 

@@ -14,8 +14,10 @@ mod mtl;
 mod obj;
 mod toml_file;
 
-use glam::{Vec3, Vec3A};
+use glam::{Vec2, Vec3, Vec3A, Vec4};
 use std::path::PathBuf;
+
+use crate::texture::{Texture, TextureRef};
 
 pub use loader::{
     camera_toml, load_scene, max_light_intensity, parse_camera_toml, without_os_error_code,
@@ -59,12 +61,88 @@ pub struct Film {
     pub height: u32,
 }
 
-/// Lambertian albedo plus a perfect mirror; `diffuse + mirror <= 1` per channel.
+/// Lambertian albedo plus a perfect mirror; `diffuse + mirror <= 1` per channel. A base
+/// colour texture and vertex colours multiply both (so the bound holds at every texel).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Material {
     pub name: String,
     pub diffuse: Vec3,
     pub mirror: Vec3,
+    /// The base colour texture (glTF `baseColorTexture`, MTL `map_Kd`): its RGB multiplies
+    /// `diffuse` and `mirror`, its alpha the opacity.
+    pub texture: Option<TextureRef>,
+    /// Whether the triangles' vertex colours ([`TriAttributes::color`], glTF `COLOR_0`)
+    /// multiply the colour and the opacity.
+    pub vertex_colors: bool,
+    pub alpha: Alpha,
+}
+
+impl Material {
+    /// An opaque material of constant colour.
+    pub fn new(name: impl Into<String>, diffuse: Vec3, mirror: Vec3) -> Material {
+        Material {
+            name: name.into(),
+            diffuse,
+            mirror,
+            texture: None,
+            vertex_colors: false,
+            alpha: Alpha::OPAQUE,
+        }
+    }
+
+    /// Whether rays test this material's opacity where they hit it (its triangles are cut
+    /// out where opacity < cutoff): [`AlphaMode::Mask`].
+    pub fn alpha_tested(&self) -> bool {
+        matches!(self.alpha.mode, AlphaMode::Mask { .. })
+    }
+
+    /// Whether its triangles need [`TriAttributes`] (texture coordinates or colours).
+    pub fn uses_attributes(&self) -> bool {
+        self.texture.is_some() || self.vertex_colors
+    }
+}
+
+/// How a material's opacity shapes its geometry.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum AlphaMode {
+    /// Every point of the surface is there, whatever its alpha.
+    Opaque,
+    /// A point is there where opacity >= `cutoff` and cut out (every ray passes) elsewhere
+    /// (glTF MASK; BLEND, MTL `d` and `map_d` are read as masks at 0.5: see the loaders).
+    Mask { cutoff: f32 },
+}
+
+/// A material's opacity: `factor` (glTF's base colour factor alpha, MTL `d`) times the
+/// texture's alpha and the vertex colours' alpha, tested by `mode`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Alpha {
+    pub mode: AlphaMode,
+    pub factor: f32,
+}
+
+impl Alpha {
+    pub const OPAQUE: Alpha = Alpha {
+        mode: AlphaMode::Opaque,
+        factor: 1.0,
+    };
+}
+
+/// What a textured or vertex-coloured triangle carries besides its geometry, per vertex
+/// (in the order of [`Triangle::v`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TriAttributes {
+    /// Texture coordinates (the set its material's texture reads), glTF convention: (0, 0)
+    /// is the image's top-left corner ([`crate::texture`]).
+    pub uv: [Vec2; 3],
+    /// Linear RGBA vertex colours (1 where the mesh has none).
+    pub color: [Vec4; 3],
+}
+
+impl TriAttributes {
+    pub const NONE: TriAttributes = TriAttributes {
+        uv: [Vec2::ZERO; 3],
+        color: [Vec4::ONE; 3],
+    };
 }
 
 /// A point light of radiant intensity `intensity` (W/sr, RGB); total power 4 pi I.
@@ -171,6 +249,11 @@ pub struct Scene {
     pub film: Film,
     pub triangles: Vec<Triangle>,
     pub materials: Vec<Material>,
+    /// The images that materials' [`Material::texture`] index.
+    pub textures: Vec<Texture>,
+    /// Empty, or one entry per triangle (in the order of [`Scene::triangles`]) where some
+    /// material [`uses_attributes`](Material::uses_attributes).
+    pub attributes: Vec<TriAttributes>,
     pub lights: Vec<PointLight>,
     /// Where the scene came from (a file, or `builtin:NAME`), for messages and reports.
     pub source: String,

@@ -199,11 +199,7 @@ fn cornell_box() -> Scene {
             });
         }
     }
-    let material = |name: &str, diffuse: [f32; 3]| Material {
-        name: name.to_string(),
-        diffuse: Vec3::from(diffuse),
-        mirror: Vec3::ZERO,
-    };
+    let material = |name: &str, diffuse: [f32; 3]| Material::new(name, Vec3::from(diffuse), Vec3::ZERO);
     // Published camera: focal length 35 mm, 25 x 25 mm film, so the vertical field of view
     // is 2 atan(12.5 / 35) = 39.3 degrees.
     let fov_y_deg = 2.0 * (12.5f32 / 35.0).atan().to_degrees();
@@ -222,6 +218,8 @@ fn cornell_box() -> Scene {
             height: 512,
         },
         triangles,
+        textures: Vec::new(),
+        attributes: Vec::new(),
         materials: vec![
             // Index order matches WHITE, RED, GREEN.
             material("white", [0.725, 0.71, 0.68]),

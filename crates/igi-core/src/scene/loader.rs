@@ -395,6 +395,8 @@ pub(super) fn load_scene_str_within(
         film,
         triangles,
         materials,
+        textures: Vec::new(),
+        attributes: Vec::new(),
         lights,
         source: name.to_string(),
         files,

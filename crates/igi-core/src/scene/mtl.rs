@@ -169,11 +169,11 @@ pub(super) fn resolve_material(
             ));
         }
     }
-    Ok(Some(Material {
-        name: full_name.to_string(),
-        diffuse: Vec3::from(diffuse.value),
-        mirror: Vec3::from(mirror.value),
-    }))
+    Ok(Some(Material::new(
+        full_name,
+        Vec3::from(diffuse.value),
+        Vec3::from(mirror.value),
+    )))
 }
 
 pub(super) fn undefined_material(

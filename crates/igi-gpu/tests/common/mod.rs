@@ -56,11 +56,7 @@ pub fn mirror_floor(diffuse: Vec3, mirror: Vec3) -> Scene {
 }
 
 pub fn material(name: &str, diffuse: Vec3, mirror: Vec3) -> Material {
-    Material {
-        name: name.into(),
-        diffuse,
-        mirror,
-    }
+    Material::new(name, diffuse, mirror)
 }
 
 /// The square [-half, half]^2 of the plane y = 0 as two triangles facing +y.
@@ -100,6 +96,8 @@ pub fn scene(
         },
         triangles,
         materials,
+        textures: Vec::new(),
+        attributes: Vec::new(),
         lights,
         source: "test".into(),
         files: vec![],
