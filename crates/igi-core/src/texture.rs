@@ -145,7 +145,9 @@ impl Texture {
         texels: Vec<[u8; 4]>,
     ) -> Result<Texture, String> {
         if width == 0 || height == 0 {
-            return Err(format!("{name}: the image has no texels ({width} x {height})"));
+            return Err(format!(
+                "{name}: the image has no texels ({width} x {height})"
+            ));
         }
         if width > MAX_TEXTURE_SIDE || height > MAX_TEXTURE_SIDE {
             return Err(format!(
@@ -249,12 +251,7 @@ fn encode(v: Vec4, srgb: bool) -> [u8; 4] {
         let e = if curve { linear_to_srgb(x) } else { x };
         (e.clamp(0.0, 1.0) * 255.0).round() as u8
     };
-    [
-        c(v.x, srgb),
-        c(v.y, srgb),
-        c(v.z, srgb),
-        c(v.w, false),
-    ]
+    [c(v.x, srgb), c(v.y, srgb), c(v.z, srgb), c(v.w, false)]
 }
 
 /// The texel index that integer coordinate `i` reads along a side of `n` texels (twin of
@@ -336,6 +333,26 @@ pub fn sample(texture: &Texture, sampler: &Sampler, uv: Vec2, lod: f32) -> Vec4 
     }
 }
 
+/// The colour multiplier (rgb) and opacity (a) of triangle `tri`'s material at
+/// barycentrics (u, v): its texture times its vertex colours (twin of texture.wgsl's
+/// `surface_color`; the GPU keeps colours to 16 bits).
+pub fn surface_color(scene: &crate::scene::Scene, tri: usize, u: f32, v: f32, lod: f32) -> Vec4 {
+    let m = &scene.materials[scene.triangles[tri].material as usize];
+    let mut c = Vec4::ONE;
+    let Some(a) = scene.attributes.get(tri) else {
+        return c;
+    };
+    let w = 1.0 - u - v;
+    if m.vertex_colors {
+        c = w * a.color[0] + u * a.color[1] + v * a.color[2];
+    }
+    if let Some(t) = &m.texture {
+        let uv = t.transform.apply(w * a.uv[0] + u * a.uv[1] + v * a.uv[2]);
+        c *= sample(&scene.textures[t.texture as usize], &t.sampler, uv, lod);
+    }
+    c
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -365,16 +382,23 @@ mod tests {
         let t = Texture::new("odd".into(), 5, 3, false, vec![[10, 20, 30, 40]; 15]).unwrap();
         let sizes: Vec<_> = t.levels.iter().map(|l| (l.width, l.height)).collect();
         assert_eq!(sizes, [(5, 3), (2, 1), (1, 1)]);
-        assert!(t.levels.iter().all(|l| l.texels.iter().all(|&x| x == [10, 20, 30, 40])));
+        assert!(t
+            .levels
+            .iter()
+            .all(|l| l.texels.iter().all(|&x| x == [10, 20, 30, 40])));
     }
 
     #[test]
     fn wrap_modes_at_and_past_the_edges() {
         let r: Vec<_> = (-4..8).map(|i| wrap_index(i, 3, Wrap::Repeat)).collect();
         assert_eq!(r, [2, 0, 1, 2, 0, 1, 2, 0, 1, 2, 0, 1]);
-        let c: Vec<_> = (-2..5).map(|i| wrap_index(i, 3, Wrap::ClampToEdge)).collect();
+        let c: Vec<_> = (-2..5)
+            .map(|i| wrap_index(i, 3, Wrap::ClampToEdge))
+            .collect();
         assert_eq!(c, [0, 0, 0, 1, 2, 2, 2]);
-        let m: Vec<_> = (-4..8).map(|i| wrap_index(i, 3, Wrap::MirroredRepeat)).collect();
+        let m: Vec<_> = (-4..8)
+            .map(|i| wrap_index(i, 3, Wrap::MirroredRepeat))
+            .collect();
         // Texel -1 mirrors to 0, -3 to 2, 3 to 2 (a copy reflected at each edge).
         assert_eq!(m, [2, 2, 1, 0, 0, 1, 2, 2, 1, 0, 0, 1]);
     }
@@ -398,7 +422,13 @@ mod tests {
         assert_eq!(at(0.75, Filter::Linear), 1.0);
         assert!((at(0.5, Filter::Linear) - 0.5).abs() < 1e-6);
         // Repeat blends the last texel with the first across the edge.
-        let r = sample_level(l, false, Vec2::new(0.0, 0.5), Filter::Linear, (Wrap::Repeat, Wrap::Repeat));
+        let r = sample_level(
+            l,
+            false,
+            Vec2::new(0.0, 0.5),
+            Filter::Linear,
+            (Wrap::Repeat, Wrap::Repeat),
+        );
         assert!((r.x - 0.5).abs() < 1e-6);
     }
 
@@ -422,7 +452,11 @@ mod tests {
         assert!((far.x - 0.5).abs() < 0.003, "{far}");
         let near = sample(&t, &s, Vec2::new(0.5 / 16.0, 0.5 / 16.0), -1.0);
         assert_eq!(near.x, 1.0);
-        let level0_only = Sampler { mip: None, min: Filter::Nearest, ..s };
+        let level0_only = Sampler {
+            mip: None,
+            min: Filter::Nearest,
+            ..s
+        };
         let v = sample(&t, &level0_only, Vec2::new(0.5 / 16.0, 0.5 / 16.0), 5.0);
         assert_eq!(v.x, 1.0);
     }

@@ -48,12 +48,19 @@ pub fn surface_at(scene: &Scene, bvh: &Bvh, dir: Vec3, slot: u32, u: f32, v: f32
         ns = -ns;
     }
     let m = &scene.materials[tri.material as usize];
+    // Particles read level 0 (vpl.wgsl: a point sample).
+    let c = if m.uses_attributes() {
+        crate::texture::surface_color(scene, bvh.tri_order[slot as usize] as usize, u, v, 0.0)
+            .truncate()
+    } else {
+        Vec3::ONE
+    };
     SurfaceHit {
         position,
         geometric_normal: ng,
         shading_normal: ns,
-        diffuse: m.diffuse,
-        mirror: m.mirror,
+        diffuse: m.diffuse * c,
+        mirror: m.mirror * c,
     }
 }
 

@@ -47,7 +47,7 @@ pub const SOFTWARE_VPLS_PER_DISPATCH: u32 = 8;
 /// The most storage buffers one pipeline of igi binds (the direct pass's; a test counts
 /// them in the shaders) where its parameter blocks are uniform buffers (GPUs). wgpu's GL
 /// backend offers fewer on some drivers (llvmpipe: 16).
-pub const STORAGE_BUFFERS_PER_STAGE: u32 = 19;
+pub const STORAGE_BUFFERS_PER_STAGE: u32 = 21;
 
 /// The most storage buffers one pipeline of igi binds with its parameter blocks bound as
 /// `params` (software adapters bind them as storage buffers too).

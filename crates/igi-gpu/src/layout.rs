@@ -27,14 +27,135 @@ pub struct TriShading {
     pub _pad2: u32,
 }
 
-/// A material (32 bytes): diffuse albedo at 0, mirror reflectance at 16 (rgb + pad each).
+/// A material (64 bytes; texture.wgsl reads the texture fields).
+/// | offset | field | |
+/// |---|---|---|
+/// | 0 | diffuse: vec3f | diffuse albedo (times the texture and vertex colours at a hit) |
+/// | 12 | texture: u32 | texture index, or `NO_TEXTURE` (0xffffffff) |
+/// | 16 | mirror: vec3f | mirror reflectance (times the same) |
+/// | 28 | flags: u32 | [`material_flags`]: vertex colours, alpha test, sampler |
+/// | 32 | uv_row0: vec3f | texture transform: u' = dot(uv_row0, (u, v, 1)) |
+/// | 44 | alpha_factor: f32 | opacity factor (times texture and vertex alpha) |
+/// | 48 | uv_row1: vec3f | v' = dot(uv_row1, (u, v, 1)) |
+/// | 60 | alpha_cutoff: f32 | alpha-tested points under this opacity are cut out |
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct GpuMaterial {
     pub diffuse: [f32; 3],
-    pub _pad0: f32,
+    pub texture: u32,
     pub mirror: [f32; 3],
-    pub _pad1: f32,
+    pub flags: u32,
+    pub uv_row0: [f32; 3],
+    pub alpha_factor: f32,
+    pub uv_row1: [f32; 3],
+    pub alpha_cutoff: f32,
+}
+
+/// `GpuMaterial::texture` of a material without one.
+pub const NO_TEXTURE: u32 = u32::MAX;
+
+/// `GpuMaterial::flags` (texture.wgsl's MAT_* constants): bit 0 vertex colours, bit 1
+/// alpha-tested, bits 2-3 and 4-5 the s and t wrap modes (0 repeat, 1 clamp to edge, 2
+/// mirrored repeat), bit 6 linear magnification, bit 7 linear minification, bit 8
+/// mipmaps, bit 9 linear between mip levels.
+pub fn material_flags(m: &igi_core::scene::Material) -> u32 {
+    use igi_core::texture::{Filter, Wrap};
+    let wrap = |w: Wrap| match w {
+        Wrap::Repeat => 0,
+        Wrap::ClampToEdge => 1,
+        Wrap::MirroredRepeat => 2,
+    };
+    let mut flags = u32::from(m.vertex_colors) | (u32::from(m.alpha_tested()) << 1);
+    if let Some(t) = &m.texture {
+        let s = &t.sampler;
+        flags |= wrap(s.wrap_s) << 2 | wrap(s.wrap_t) << 4;
+        flags |= u32::from(s.mag == Filter::Linear) << 6;
+        flags |= u32::from(s.min == Filter::Linear) << 7;
+        flags |= u32::from(s.mip.is_some()) << 8;
+        flags |= u32::from(s.mip == Some(Filter::Linear)) << 9;
+    }
+    flags
+}
+
+impl GpuMaterial {
+    pub fn of(m: &igi_core::scene::Material) -> GpuMaterial {
+        use igi_core::scene::AlphaMode;
+        let transform = m
+            .texture
+            .map_or(igi_core::texture::UvTransform::IDENTITY, |t| t.transform);
+        GpuMaterial {
+            diffuse: m.diffuse.to_array(),
+            texture: m.texture.map_or(NO_TEXTURE, |t| t.texture),
+            mirror: m.mirror.to_array(),
+            flags: material_flags(m),
+            uv_row0: transform.rows[0].to_array(),
+            alpha_factor: m.alpha.factor,
+            uv_row1: transform.rows[1].to_array(),
+            alpha_cutoff: match m.alpha.mode {
+                AlphaMode::Mask { cutoff } => cutoff,
+                AlphaMode::Opaque => 0.0,
+            },
+        }
+    }
+}
+
+/// Texture coordinates and vertex colours of one triangle in BVH order (48 bytes).
+/// | offset | field | |
+/// |---|---|---|
+/// | 0 | uv01: vec4f | texture coordinates of corners 0 (xy) and 1 (zw) |
+/// | 16 | uv2: vec2f | corner 2 |
+/// | 24 | color0: vec2u | linear RGBA of corner 0 as two pack2x16unorm words (rg, ba) |
+/// | 32 | color1: vec2u | corner 1 |
+/// | 40 | color2: vec2u | corner 2 |
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuTriAttributes {
+    pub uv01: [f32; 4],
+    pub uv2: [f32; 2],
+    pub color0: [u32; 2],
+    pub color1: [u32; 2],
+    pub color2: [u32; 2],
+}
+
+impl GpuTriAttributes {
+    pub fn of(a: &igi_core::scene::TriAttributes) -> GpuTriAttributes {
+        let [u0, u1, u2] = a.uv;
+        // As WGSL's pack2x16unorm: clamped to [0, 1], times 65535, rounded.
+        let unorm = |x: f32| (x.clamp(0.0, 1.0) * 65535.0).round() as u32;
+        let color =
+            |c: igi_core::Vec4| [unorm(c.x) | unorm(c.y) << 16, unorm(c.z) | unorm(c.w) << 16];
+        GpuTriAttributes {
+            uv01: [u0.x, u0.y, u1.x, u1.y],
+            uv2: [u2.x, u2.y],
+            color0: color(a.color[0]),
+            color1: color(a.color[1]),
+            color2: color(a.color[2]),
+        }
+    }
+}
+
+/// The words of the textures buffer (scene.wgsl's `textures`): a header of 4 words per
+/// texture (width, height, level count with bit 8 set where colours are sRGB, the word of
+/// its first texel), then each texture's levels in order, one RGBA8 word per texel (red in
+/// the low byte, as unpack4x8unorm reads it). At least one (zero) header.
+pub fn texture_words(textures: &[igi_core::texture::Texture]) -> Vec<u32> {
+    let headers = 4 * textures.len().max(1);
+    let texels: usize = textures.iter().map(|t| t.texel_count()).sum();
+    let mut words = vec![0u32; headers];
+    words.reserve(texels);
+    for (i, t) in textures.iter().enumerate() {
+        let first = words.len() as u32;
+        words[4 * i..4 * i + 4].copy_from_slice(&[
+            t.width,
+            t.height,
+            t.levels.len() as u32 | u32::from(t.srgb) << 8,
+            first,
+        ]);
+        for level in &t.levels {
+            words.extend(level.texels.iter().map(|&c| u32::from_le_bytes(c)));
+        }
+    }
+    words
 }
 
 /// A point light (32 bytes): position at 0, intensity (W/sr, rgb) at 16.

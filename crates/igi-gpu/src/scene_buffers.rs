@@ -2,8 +2,8 @@
 //! materials and lights, as bind group 0 of every pass (`shaders/scene.wgsl`).
 
 use crate::context::{GpuContext, GpuError};
-use crate::layout::{GpuLight, GpuMaterial, TriShading};
-use igi_core::bvh::Bvh;
+use crate::layout::{texture_words, GpuLight, GpuMaterial, GpuTriAttributes, TriShading};
+use igi_core::bvh::{Bvh, TriRow};
 use igi_core::scene::Scene;
 use igi_core::trace_scale::TraceScale;
 
@@ -42,6 +42,8 @@ crate::bindings! {
         lights: Read,
         /// Rays traced per kind, counted only in frames that count them.
         ray_counters: Write,
+        textures: Read,
+        tri_attributes: Read,
     }
 }
 
@@ -137,23 +139,30 @@ impl SceneBuffers {
                 }
             })
             .collect();
-        let materials: Vec<GpuMaterial> = scene
-            .materials
-            .iter()
-            .map(|m| GpuMaterial {
-                diffuse: m.diffuse.to_array(),
-                _pad0: 0.0,
-                mirror: m.mirror.to_array(),
-                _pad1: 0.0,
-            })
-            .collect();
+        let materials: Vec<GpuMaterial> = scene.materials.iter().map(GpuMaterial::of).collect();
         let lights = gpu_lights(&scene.lights, scale);
+        let tri_rows = marked_rows(scene, bvh);
+        let attributes = gpu_attributes(scene, bvh)?;
         let buffers = [
             storage_buffer(ctx, "BVH nodes", bytemuck::cast_slice(&bvh.nodes))?,
-            storage_buffer(ctx, "triangle rows", bytemuck::cast_slice(&bvh.tri_rows))?,
+            storage_buffer(
+                ctx,
+                "triangle rows",
+                bytemuck::cast_slice(tri_rows.as_deref().unwrap_or(&bvh.tri_rows)),
+            )?,
             storage_buffer(ctx, "triangle shading", bytemuck::cast_slice(&shading))?,
             storage_buffer(ctx, "materials", bytemuck::cast_slice(&materials))?,
             storage_buffer(ctx, "lights", bytemuck::cast_slice(&lights))?,
+            storage_buffer(
+                ctx,
+                "textures",
+                bytemuck::cast_slice(&texture_words(&scene.textures)),
+            )?,
+            storage_buffer(
+                ctx,
+                "triangle attributes",
+                bytemuck::cast_slice(&attributes),
+            )?,
         ];
         let bytes = buffers.iter().map(|b| b.size()).sum();
         let ray_counters = storage_buffer(ctx, "ray counters", &[0u8; 32])?;
@@ -162,7 +171,8 @@ impl SceneBuffers {
             spare_counters.push(storage_buffer(ctx, "spare ray counters", &[0u8; 32])?);
         }
         let group = |label: &str, ray_counters: &wgpu::Buffer| {
-            let [bvh_nodes, tri_rows, tri_shading, materials, lights] = &buffers;
+            let [bvh_nodes, tri_rows, tri_shading, materials, lights, textures, tri_attributes] =
+                &buffers;
             let bindings = SceneBindings {
                 bvh_nodes,
                 tri_rows,
@@ -170,13 +180,15 @@ impl SceneBuffers {
                 materials,
                 lights,
                 ray_counters,
+                textures,
+                tri_attributes,
             };
             crate::passes::bindings::bind(&ctx.device, label, &layout, &bindings).group
         };
         let bind_group = group("scene", &ray_counters);
         let beside_bind_groups =
             std::array::from_fn(|i| group("scene (spare ray counters)", &spare_counters[i]));
-        let [_, _, _, _, lights_buffer] = buffers;
+        let [_, _, _, _, lights_buffer, _, _] = buffers;
         Ok(SceneBuffers {
             layout,
             bind_group,
@@ -188,4 +200,53 @@ impl SceneBuffers {
             bytes,
         })
     }
+}
+
+/// The triangle rows with w = 1 in the three rows of every slot whose material is
+/// alpha-tested (traverse.wgsl tests those slots' masks), or `None` where no material is
+/// (the BVH's rows, w = 0, are used as they are).
+fn marked_rows(scene: &Scene, bvh: &Bvh) -> Option<Vec<TriRow>> {
+    let tested: Vec<bool> = scene.materials.iter().map(|m| m.alpha_tested()).collect();
+    if !tested.contains(&true) {
+        return None;
+    }
+    let mut rows = bvh.tri_rows.clone();
+    for (slot, &t) in bvh.tri_order.iter().enumerate() {
+        let material = scene.triangles[t as usize].material as usize;
+        if tested.get(material).copied().unwrap_or(false) {
+            for row in &mut rows[3 * slot..3 * slot + 3] {
+                row.0[3] = 1.0;
+            }
+        }
+    }
+    Some(rows)
+}
+
+/// The triangles' texture coordinates and colours in BVH order, or one unused row where
+/// the scene has none.
+fn gpu_attributes(scene: &Scene, bvh: &Bvh) -> Result<Vec<GpuTriAttributes>, GpuError> {
+    if scene.attributes.is_empty() {
+        if scene.materials.iter().any(|m| m.uses_attributes()) {
+            return Err(GpuError::Device(format!(
+                "{}: a material has a texture or vertex colours but the scene has no texture coordinates or colours",
+                scene.source
+            )));
+        }
+        return Ok(vec![GpuTriAttributes::of(
+            &igi_core::scene::TriAttributes::NONE,
+        )]);
+    }
+    if scene.attributes.len() != scene.triangles.len() {
+        return Err(GpuError::Device(format!(
+            "{}: {} triangle attribute rows for {} triangles",
+            scene.source,
+            scene.attributes.len(),
+            scene.triangles.len()
+        )));
+    }
+    Ok(bvh
+        .tri_order
+        .iter()
+        .map(|&t| GpuTriAttributes::of(&scene.attributes[t as usize]))
+        .collect())
 }

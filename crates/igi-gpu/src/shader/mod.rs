@@ -14,6 +14,7 @@ pub use resolve::ResolveError;
 pub const MODULES: &[(&str, &str)] = &[
     ("scene", include_str!("../shaders/scene.wgsl")),
     ("traverse", include_str!("../shaders/traverse.wgsl")),
+    ("texture", include_str!("../shaders/texture.wgsl")),
     ("params", include_str!("../shaders/params.wgsl")),
     ("constants", include_str!("../shaders/constants.wgsl")),
     ("sampling", include_str!("../shaders/sampling.wgsl")),

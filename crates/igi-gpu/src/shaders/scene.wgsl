@@ -19,9 +19,22 @@ struct TriShading {
     n2: vec3<f32>, _pad2: u32,
 }
 
+// A material (layout.rs's GpuMaterial documents each field): its colours, and how its
+// base colour texture, vertex colours and alpha mask modulate them (texture.wgsl).
 struct Material {
-    diffuse: vec3<f32>, _pad0: f32,
-    mirror: vec3<f32>, _pad1: f32,
+    diffuse: vec3<f32>, texture: u32,
+    mirror: vec3<f32>, flags: u32,
+    uv_row0: vec3<f32>, alpha_factor: f32,
+    uv_row1: vec3<f32>, alpha_cutoff: f32,
+}
+
+// Texture coordinates and linear RGBA colours of a triangle's corners (BVH order), read
+// only for materials with a texture or vertex colours; each colour is two
+// pack2x16unorm words (rg, ba).
+struct TriAttributes {
+    uv01: vec4<f32>,
+    uv2: vec2<f32>, color0: vec2<u32>,
+    color1: vec2<u32>, color2: vec2<u32>,
 }
 
 struct PointLight {
@@ -42,3 +55,10 @@ struct PointLight {
 // Entry CUT_WALKS counts walks a software adapter cut short (traverse.wgsl), always.
 @group(0) @binding(5) var<storage, read_write> ray_counters: array<atomic<u32>, 8>;
 const CUT_WALKS: u32 = 7u;
+// The textures: a header of 4 words per texture (width, height, mip levels, the word
+// where its level 0 starts), then the texels, one RGBA8 word each (red in the low byte),
+// each texture's levels one after the other, rows from the top (layout.rs,
+// texture_words). At least one header, so the buffer is never empty.
+@group(0) @binding(6) var<storage, read> textures: array<u32>;
+// One row per triangle in BVH order where some material reads them, else one.
+@group(0) @binding(7) var<storage, read> tri_attributes: array<TriAttributes>;

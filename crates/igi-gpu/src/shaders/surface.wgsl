@@ -3,6 +3,7 @@
 
 #import scene
 #import traverse
+#import texture
 
 // What a closest hit looks like to shading. Surfaces are two-sided: both normals face the
 // side the ray came from.
@@ -36,7 +37,9 @@ fn geometric_normal(v0: vec3<f32>, v1: vec3<f32>, v2: vec3<f32>) -> vec3<f32> {
     return normalize(cross(scale_pow2(v1 - v0), scale_pow2(v2 - v0)));
 }
 
-fn surface_at(origin: vec3<f32>, dir: vec3<f32>, hit: Hit) -> SurfaceHit {
+// The hit `hit` of the ray (origin, dir), seen by a ray cone `cone_width` wide there
+// (which picks the texture's mip level: texture.wgsl's cone_lod; 0 reads level 0).
+fn surface_at(origin: vec3<f32>, dir: vec3<f32>, hit: Hit, cone_width: f32) -> SurfaceHit {
     var s: SurfaceHit;
     let x = tri_rows[3u * hit.tri].xyz;
     let y = tri_rows[3u * hit.tri + 1u].xyz;
@@ -63,5 +66,14 @@ fn surface_at(origin: vec3<f32>, dir: vec3<f32>, hit: Hit) -> SurfaceHit {
     let m = materials[sh.material];
     s.diffuse = m.diffuse;
     s.mirror = m.mirror;
+    if (m.texture != NO_TEXTURE || (m.flags & MAT_VERTEX_COLORS) != 0u) {
+        var lod = 0.0;
+        if (m.texture != NO_TEXTURE) {
+            lod = cone_lod(m.texture, m, tri_attributes[hit.tri], v0, v1, v2, cone_width, dot(dir, ng));
+        }
+        let c = surface_color(m, hit.tri, hit.u, hit.v, lod).xyz;
+        s.diffuse *= c;
+        s.mirror *= c;
+    }
     return s;
 }

@@ -13,6 +13,7 @@
 // the inside test compares rounded products and never looks at a fused difference.
 
 #import scene
+#import texture
 
 // Hit.tri of a miss.
 const NO_HIT: u32 = 0xffffffffu;
@@ -269,15 +270,25 @@ fn intersect_triangle(r: TraceRay, xr: vec3<f32>, yr: vec3<f32>, zr: vec3<f32>, 
 
 // The rows of BVH slot `slot` in the ray's Woop axes (the test's xr, yr, zr), read by
 // index: the twin of igi_core's slot_rows.
+// `tested`: the rows' w is not 0 where the slot's material is alpha-tested (every row of
+// the slot says so: the ray reads them in its own order).
 struct WoopRows {
     x: vec3<f32>,
     y: vec3<f32>,
     z: vec3<f32>,
+    tested: bool,
 }
 
 fn slot_rows(slot: u32, r: TraceRay) -> WoopRows {
     let i = 3u * slot;
-    return WoopRows(tri_rows[i + r.kx].xyz, tri_rows[i + r.ky].xyz, tri_rows[i + r.kz].xyz);
+    let x = tri_rows[i + r.kx];
+    return WoopRows(x.xyz, tri_rows[i + r.ky].xyz, tri_rows[i + r.kz].xyz, x.w != 0.0);
+}
+
+// Whether a hit at barycentrics (u, v) of a slot is a hit: not where an alpha mask cuts
+// the surface out (texture.wgsl).
+fn solid_at(rows: WoopRows, slot: u32, u: f32, v: f32) -> bool {
+    return !rows.tested || !cut_out(slot, u, v);
 }
 
 // The triangles of a leaf in slot order; equal distances keep the first hit.
@@ -287,7 +298,7 @@ fn leaf_closest(first: u32, count: u32, r: TraceRay, hit_in: Hit) -> Hit {
     for (; slot < first + count; slot++) {
         let rows = slot_rows(slot, r);
         let h = intersect_triangle(r, rows.x, rows.y, rows.z, hit.t);
-        if (h.x > 0.0) {
+        if (h.x > 0.0 && solid_at(rows, slot, h.y, h.z)) {
             hit = Hit(h.x, slot, h.y, h.z);
         }
     }
@@ -303,18 +314,21 @@ fn leaf_any(first: u32, count: u32, r: TraceRay, tmax: f32, boxes: bool) -> bool
         let i = 3u * slot;
         if (boxes) {
             // The triangle's box: per axis the extremes of that axis's row.
-            let x = tri_rows[i].xyz;
+            // Not for alpha-tested slots (w != 0): a leaf's cut-out shape is not its box,
+            // so they are tested by their triangle and texels below.
+            let row_x = tri_rows[i];
+            let x = row_x.xyz;
             let y = tri_rows[i + 1u].xyz;
             let z = tri_rows[i + 2u].xyz;
             let lo = vec3<f32>(min(x.x, min(x.y, x.z)), min(y.x, min(y.y, y.z)), min(z.x, min(z.y, z.z)));
             let hi = vec3<f32>(max(x.x, max(x.y, x.z)), max(y.x, max(y.y, y.z)), max(z.x, max(z.y, z.z)));
-            if (box_crossed(lo, hi, r, tmax)) {
+            if (row_x.w == 0.0 && box_crossed(lo, hi, r, tmax)) {
                 return true;
             }
         }
         let rows = slot_rows(slot, r);
         let h = intersect_triangle(r, rows.x, rows.y, rows.z, tmax);
-        if (h.x > 0.0) {
+        if (h.x > 0.0 && solid_at(rows, slot, h.y, h.z)) {
             return true;
         }
     }

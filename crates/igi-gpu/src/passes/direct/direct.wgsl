@@ -80,6 +80,12 @@ fn camera_ray_dir(x: u32, y: u32) -> vec3<f32> {
     return normalize(params.cam_forward + sx * params.cam_right + sy * params.cam_up);
 }
 
+// The angle one pixel subtends (at the image centre): a primary ray cone's width per
+// unit of distance.
+fn pixel_spread() -> f32 {
+    return 2.0 * params.tan_half_fov_y / f32(params.height);
+}
+
 // Irradiance from the point lights at p (shadow rays from the surface to each light).
 fn direct_irradiance(stack: ptr<function, WalkStack>, p: vec3<f32>, ng: vec3<f32>, ns: vec3<f32>) -> vec3<f32> {
     var e = vec3<f32>(0.0);
@@ -136,7 +142,9 @@ fn shade(x: u32, y: u32) {
         if (hit.tri == NO_HIT) {
             break;
         }
-        let s = surface_at(origin, dir, hit);
+        // The pixel's ray cone (its width grows by the pixel's angle per unit of length,
+        // and flat mirrors keep the angle) picks the texture level.
+        let s = surface_at(origin, dir, hit, pixel_spread() * (travelled + hit.t));
         travelled += hit.t;
         if (depth == 0u && first_walk) {
             gbuf_position[pixel] = pack_position(s.position);

@@ -121,7 +121,9 @@ fn shoot_path(path: u32) -> u32 {
         if (hit.tri == NO_HIT) {
             break;
         }
-        let s = surface_at(origin, dir, hit);
+        // Level 0: a particle is a point sample, whose albedos average to the texture's
+        // over the paths.
+        let s = surface_at(origin, dir, hit, 0.0);
         if (max(s.diffuse.x, max(s.diffuse.y, s.diffuse.z)) > 0.0) {
             var v: Vpl;
             v.position = s.position;
