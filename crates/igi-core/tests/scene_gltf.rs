@@ -307,17 +307,8 @@ fn png_2x2(texels: [[u8; 3]; 4]) -> Vec<u8> {
     out
 }
 
-fn srgb_to_linear(v: u8) -> f32 {
-    let c = f32::from(v) / 255.0;
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
-}
-
 #[test]
-fn base_color_texture_is_averaged_in_linear() {
+fn base_color_texture_becomes_a_texture() {
     let dir = TestDir::new("texture");
     let texels = [[255, 0, 0], [0, 255, 0], [0, 0, 255], [128, 64, 32]];
     dir.write("tex.png", png_2x2(texels));
@@ -325,6 +316,10 @@ fn base_color_texture_is_averaged_in_linear() {
     let mut g = Gltf::default();
     let p = g.positions(&QUAD);
     let i = g.indices(&QUAD_INDICES);
+    let uv = g.view(&[0u8; 32]);
+    let uv = g.accessor(format!(
+        r#"{{"bufferView": {uv}, "componentType": 5126, "count": 4, "type": "VEC2"}}"#
+    ));
     g.images.push(r#"{"uri": "tex.png"}"#.to_string());
     g.images.push(r#"{"uri": "bad.png"}"#.to_string());
     // The same PNG again, embedded in the buffer.
@@ -340,34 +335,28 @@ fn base_color_texture_is_averaged_in_linear() {
     g.material(
         r#"{"name": "embedded", "pbrMetallicRoughness": {"baseColorTexture": {"index": 2}, "metallicFactor": 0.0}}"#,
     );
-    g.mesh(&[
-        primitive(p, Some(i), r#", "material": 0"#),
-        primitive(p, Some(i), r#", "material": 1"#),
-        primitive(p, Some(i), r#", "material": 2"#),
-    ]);
+    let attrs = format!(r#""attributes": {{"POSITION": {p}, "TEXCOORD_0": {uv}}}"#);
+    g.mesh(&[0, 1, 2].map(|m| format!(r#"{{{attrs}, "indices": {i}, "material": {m}}}"#)));
     g.node(r#""mesh": 0"#);
     dir.write("tex.gltf", g.gltf());
     let s = dir.load(&scene_toml("tex.gltf", LIGHT)).unwrap();
 
-    // The average of the decoded texels, not the decoded average of the codes.
-    let mut avg = Vec3::ZERO;
-    for t in texels {
-        avg += Vec3::new(
-            srgb_to_linear(t[0]),
-            srgb_to_linear(t[1]),
-            srgb_to_linear(t[2]),
-        ) / 4.0;
-    }
+    // The factor stays the material's colour; the texture multiplies it where shaded.
     let m = material(&s, "textured");
-    assert_close(m.diffuse, Vec3::new(0.5, 1.0, 1.0) * avg);
-    assert!((m.diffuse.x - 0.5 * (1.0 + srgb_to_linear(128)) / 4.0).abs() < 1e-6);
+    assert_eq!(m.diffuse, Vec3::new(0.5, 1.0, 1.0));
     assert_eq!(m.mirror, Vec3::ZERO);
+    let t = &s.textures[m.texture.expect("a texture").texture as usize];
+    assert!(t.srgb);
+    let rgba: Vec<[u8; 4]> = texels.iter().map(|&[r, g, b]| [r, g, b, 255]).collect();
+    assert_eq!(t.levels[0].texels, rgba);
     // An image that cannot be decoded: a warning, and the factor alone.
-    assert_close(
-        material(&s, "undecodable").diffuse,
-        Vec3::new(0.25, 0.5, 0.75),
-    );
-    assert_close(material(&s, "embedded").diffuse, avg);
+    let bad = material(&s, "undecodable");
+    assert_eq!(bad.texture, None);
+    assert_close(bad.diffuse, Vec3::new(0.25, 0.5, 0.75));
+    let embedded = material(&s, "embedded");
+    let e = &s.textures[embedded.texture.expect("a texture").texture as usize];
+    assert_eq!(e.levels[0].texels, rgba);
+    assert_eq!(s.textures.len(), 2, "the file and the buffer view");
     assert!(s.files.iter().any(|f| f.ends_with("tex.png")));
 }
 
@@ -779,14 +768,29 @@ fn features_igi_does_not_render_are_listed() {
             .join(", ")
     };
     let cases = [
-        ("VertexColorTest", "COLOR_0 vertex colours"),
-        ("AlphaBlendModeTest", "alpha modes MASK and BLEND"),
         ("MultiUVTest", "a second texture coordinate set"),
         ("NormalTangentTest", "normal maps"),
     ];
     for (name, what) in cases {
         let list = ignored(name);
         assert!(list.contains(what), "{name}: {list:?}");
+    }
+    // Rendered now: vertex colours, alpha modes, texture transforms.
+    for (name, what) in [
+        ("VertexColorTest", "COLOR_0"),
+        ("AlphaBlendModeTest", "alpha"),
+        ("TextureTransformTest", "KHR_texture_transform"),
+    ] {
+        let list = match name {
+            "TextureTransformTest" => {
+                load_gltf(&samples.join("TextureTransformTest/glTF/TextureTransformTest.gltf"))
+                    .unwrap_or_else(|e| panic!("{name}: {e}"))
+                    .ignored
+                    .join(", ")
+            }
+            _ => ignored(name),
+        };
+        assert!(!list.contains(what), "{name}: {list:?}");
     }
     assert_eq!(
         ignored("Box"),

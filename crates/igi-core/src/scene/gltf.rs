@@ -1,7 +1,8 @@
 //! glTF 2.0 meshes (`.gltf` JSON and `.glb` binary) for a scene's `[[mesh]]`, read with
-//! the `gltf` crate into the loader's shapes: world-space [`Triangle`]s, materials by name
-//! (diffuse + perfect mirror, see [`pbr_to_material`]) and KHR_lights_punctual point
-//! lights as [`PointLight`]s in W/sr. The loader (`loader.rs`) calls [`load_gltf_bytes`]
+//! the `gltf` crate into the loader's shapes: world-space [`Triangle`]s with their
+//! [`TriAttributes`] (texture coordinates, vertex colours), materials by name (diffuse +
+//! perfect mirror, see [`pbr_to_material`], with a base colour [`Texture`] and an alpha
+//! mode) and KHR_lights_punctual point lights as [`PointLight`]s in W/sr. The loader (`loader.rs`) calls [`load_gltf_bytes`]
 //! for a mesh path ending in `.gltf` or `.glb` (any case, [`is_gltf_path`]) and merges the
 //! result as it does an OBJ's: materials are resolved by name, so `[materials.NAME]`
 //! overrides a glTF material key by key, and the glTF's lights join `[[point_light]]`s.
@@ -15,8 +16,13 @@
 //!   LINES* are skipped (one warning with the count). `NORMAL` gives shading normals.
 //! - Materials: name = the glTF name, `gltf:<file stem>:<index>` when it has none,
 //!   [`DEFAULT_MATERIAL`] for primitives without a material (or the mesh's
-//!   `default_material`, which the loader applies). Base colour = `baseColorFactor.rgb`
-//!   times the average linear colour of `baseColorTexture`.
+//!   `default_material`, which the loader applies). Base colour = `baseColorFactor.rgb`;
+//!   `baseColorTexture` (sRGB RGBA8, its sampler, KHR_texture_transform) and COLOR_0
+//!   multiply it where the renderer shades. alphaMode MASK is a cut-out at `alphaCutoff`,
+//!   BLEND one at 0.5 (with a warning), OPAQUE ignores alpha.
+//! - Attributes: KHR_mesh_quantization's integer positions, normals and texture
+//!   coordinates are read as the values they stand for; the TEXCOORD_n set a material's
+//!   texture reads, and COLOR_0, become per-triangle attributes.
 //! - Lights: point lights, intensity (cd = lm/sr) / [`LUMENS_PER_WATT`] -> W/sr; spot and
 //!   directional lights skipped with a warning.
 //!
@@ -47,9 +53,12 @@ use std::path::{Path, PathBuf};
 use glam::Vec3;
 
 use super::loader::{SceneError, TriangleBudget};
-use super::{PointLight, Triangle};
+use super::{Alpha, PointLight, TriAttributes, Triangle};
+use crate::texture::{Texture, TextureRef};
+
 use accessors::ReadStats;
 use document::read;
+pub use materials::DEFAULT_ALPHA_CUTOFF;
 use messages::parse;
 
 /// Luminous efficacy used to turn glTF photometric intensities (candela = lm/sr) into
@@ -89,6 +98,13 @@ pub struct GltfMaterial {
     pub index: Option<usize>,
     pub diffuse: Vec3,
     pub mirror: Vec3,
+    /// The base colour texture; [`TextureRef::texture`] indexes [`GltfMesh::textures`].
+    pub texture: Option<TextureRef>,
+    /// Whether a primitive that uses it has COLOR_0.
+    pub vertex_colors: bool,
+    /// OPAQUE, or MASK (and BLEND) as a cut-out; a mask without texture and vertex colours
+    /// is settled here: opaque where its factor passes the cutoff.
+    pub alpha: Alpha,
     /// Triangles that use it.
     pub triangles: usize,
 }
@@ -101,6 +117,11 @@ pub struct GltfMesh {
     pub triangles: Vec<Triangle>,
     /// The materials that primitives use, in order of first use.
     pub materials: Vec<GltfMaterial>,
+    /// The base colour textures of the materials (sRGB), one per image source.
+    pub textures: Vec<Texture>,
+    /// Empty, or one per triangle of [`GltfMesh::triangles`] where some material uses
+    /// texture coordinates or vertex colours (NONE for the others).
+    pub attributes: Vec<TriAttributes>,
     /// KHR_lights_punctual point lights of the scene, intensity in W/sr.
     pub lights: Vec<PointLight>,
     /// Files read besides the glTF file itself: external buffers and images.
@@ -183,9 +204,9 @@ mod test_builder;
 #[cfg(test)]
 mod tests {
     use super::document::percent_decode;
-    use super::materials::srgb_to_linear;
     use super::nodes::triangulate;
     use super::*;
+    use crate::texture::srgb_to_linear;
     use ::gltf::mesh::Mode;
 
     #[test]
@@ -320,8 +341,12 @@ mod tests {
         let (mesh, stats) = load_counting(&g, &[("t.png", png)]);
         assert_eq!(mesh.materials.len(), 61);
         assert_eq!(stats.images_decoded, 3, "one view, one file, another view");
-        let first = mesh.materials[0].diffuse;
-        assert!(mesh.materials.iter().all(|m| m.diffuse == first));
+        assert_eq!(mesh.textures.len(), 3);
+        let texture = |k: usize| mesh.materials[k].texture.map(|t| t.texture);
+        assert!((0..30).all(|k| texture(k) == Some(0)));
+        assert!((30..60).all(|k| texture(k) == Some(1)));
+        assert_eq!(texture(60), Some(2));
+        assert_eq!(mesh.textures[1].levels[0].texels, [[200, 100, 50, 255]]);
         assert_eq!(mesh.files.len(), 1, "{:?}", mesh.files);
     }
 

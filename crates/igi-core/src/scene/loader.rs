@@ -74,13 +74,13 @@ use serde::Deserialize;
 use toml::Spanned;
 
 use super::error::{as_text, quote};
-use super::mtl::{resolve_material, undefined_material, MtlDef, MtlTable};
+use super::mtl::{resolve_material, undefined_material, DefTexture, MtlDef, MtlTable};
 use super::obj::{load_obj, Slot};
 use super::toml_file::{
     camera, check_toml_material, check_total_power, film, light, toml_message, CameraDesc,
     SceneDesc, TomlFile,
 };
-use super::{Camera, Material, Scene, Triangle};
+use super::{Alpha, AlphaMode, Camera, Material, Scene, TriAttributes, Triangle};
 
 pub use super::error::{without_os_error_code, Location, SceneError};
 pub use super::toml_file::{max_light_intensity, DEFAULT_FILM, DEFAULT_UP};
@@ -134,6 +134,38 @@ impl TriangleBudget {
                 self.limit
             ),
         ))
+    }
+}
+
+/// The scene's triangles as the meshes add them, with their attributes: none until a mesh
+/// brings some, then one per triangle up to the last that has some (NONE for those
+/// before it); the loader pads or drops them at the end.
+#[derive(Default)]
+pub(super) struct Geometry {
+    pub(super) triangles: Vec<Triangle>,
+    pub(super) attributes: Vec<TriAttributes>,
+}
+
+impl Geometry {
+    pub(super) fn push(&mut self, t: Triangle, attributes: Option<TriAttributes>) {
+        if let Some(a) = attributes {
+            self.attributes
+                .resize(self.triangles.len(), TriAttributes::NONE);
+            self.attributes.push(a);
+        }
+        self.triangles.push(t);
+    }
+}
+
+/// A cut-out whose opacity cannot vary (no texture, no vertex colours) is all there or
+/// all cut out: opaque where its factor reaches the cutoff, so that rays need not test it;
+/// below the cutoff it stays a mask (every ray passes).
+pub(super) fn settled_alpha(alpha: Alpha, textured: bool, vertex_colors: bool) -> Alpha {
+    match alpha.mode {
+        AlphaMode::Mask { cutoff } if !textured && !vertex_colors && alpha.factor >= cutoff => {
+            Alpha::OPAQUE
+        }
+        _ => alpha,
     }
 }
 
@@ -258,7 +290,7 @@ pub(super) fn load_scene_str_within(
             "the scene has no [[mesh]]: at least one mesh is required",
         ));
     }
-    let mut triangles = Vec::new();
+    let mut geometry = Geometry::default();
     let mut slots: Vec<Slot> = Vec::new();
     let mut mtl = MtlTable::default();
     let mut files = Vec::new();
@@ -278,7 +310,7 @@ pub(super) fn load_scene_str_within(
         let first_slot = slots.len();
         let budget = TriangleBudget {
             limit: max_triangles,
-            used: triangles.len(),
+            used: geometry.triangles.len(),
         };
         // glTF hook: `.gltf`/`.glb` meshes are read by scene/gltf.rs (see add_gltf).
         if super::gltf::is_gltf_path(&obj_path) {
@@ -292,18 +324,20 @@ pub(super) fn load_scene_str_within(
                 mesh_index,
                 has_default,
                 &mut slots,
-                &mut triangles,
+                &mut geometry,
                 &mut mtl,
             );
             continue;
         }
+        let default_material = mesh.default_material.as_ref().map(|d| d.get_ref().as_str());
         load_obj(
             &bytes,
             &obj_path,
             mesh_index,
+            default_material,
             budget,
             &mut slots,
-            &mut triangles,
+            &mut geometry,
             &mut mtl,
             &mut files,
         )?;
@@ -357,7 +391,8 @@ pub(super) fn load_scene_str_within(
         let index = match by_name.get(mat_name) {
             Some(&index) => index,
             None => {
-                let Some(m) = resolve_material(&tf, mat_name, &desc.materials, &mtl)? else {
+                let Some(m) = resolve_material(&tf, mat_name, &desc.materials, &mut mtl, true)?
+                else {
                     return Err(undefined_material(&tf, mat_name, &how, used_at, slot));
                 };
                 let index = materials.len() as u32;
@@ -368,6 +403,10 @@ pub(super) fn load_scene_str_within(
         };
         slot_material[i] = index;
     }
+    let Geometry {
+        mut triangles,
+        mut attributes,
+    } = geometry;
     for t in &mut triangles {
         // Every triangle's slot has triangles, hence a material.
         t.material = slot_material
@@ -377,7 +416,7 @@ pub(super) fn load_scene_str_within(
     }
     for mat_name in desc.materials.keys() {
         if !by_name.contains_key(mat_name) {
-            resolve_material(&tf, mat_name, &desc.materials, &mtl)?;
+            resolve_material(&tf, mat_name, &desc.materials, &mut mtl, false)?;
             log::warn!(
                 "{name}: [materials.{}] is used by no face; ignored",
                 quote(mat_name)
@@ -390,19 +429,50 @@ pub(super) fn load_scene_str_within(
             "the scene has no triangles (its meshes have no faces, or only degenerate ones)",
         ));
     }
+    // Attributes where a material uses them (one per triangle), else none.
+    if materials.iter().any(|m| m.uses_attributes()) {
+        attributes.resize(triangles.len(), TriAttributes::NONE);
+    } else {
+        attributes = Vec::new();
+    }
+    let textures = used_textures(&mut materials, std::mem::take(&mut mtl.textures.list));
+    files.append(&mut mtl.textures.files);
     let scene = Scene {
         camera,
         film,
         triangles,
         materials,
-        textures: Vec::new(),
-        attributes: Vec::new(),
+        textures,
+        attributes,
         lights,
         source: name.to_string(),
         files,
     };
     check_scale(&scene)?;
     Ok(scene)
+}
+
+/// The textures that `materials` use, in order of first use, their indices made those of
+/// the list returned: a texture whose materials no face uses, or that `[materials.NAME]`
+/// replaced, is not kept.
+fn used_textures(
+    materials: &mut [Material],
+    all: Vec<crate::texture::Texture>,
+) -> Vec<crate::texture::Texture> {
+    let mut index: Vec<Option<u32>> = vec![None; all.len()];
+    let mut order: Vec<usize> = Vec::new();
+    for m in materials.iter_mut() {
+        if let Some(t) = &mut m.texture {
+            let old = t.texture as usize;
+            let new = *index[old].get_or_insert_with(|| {
+                order.push(old);
+                order.len() as u32 - 1
+            });
+            t.texture = new;
+        }
+    }
+    let mut all: Vec<Option<crate::texture::Texture>> = all.into_iter().map(Some).collect();
+    order.into_iter().filter_map(|i| all[i].take()).collect()
 }
 
 /// Errors where 32-bit floats cannot trace the scene (a small scene far from the origin,
@@ -441,20 +511,32 @@ fn add_gltf(
     mesh: usize,
     has_default_material: bool,
     slots: &mut Vec<Slot>,
-    triangles: &mut Vec<Triangle>,
+    geometry: &mut Geometry,
     mtl: &mut MtlTable,
 ) {
     let file = path.display().to_string();
     let slot_base = slots.len();
+    // The file's textures join the scene's; its materials' indices follow them.
+    let texture_base = mtl.textures.list.len() as u32;
+    for t in g.textures {
+        mtl.textures.push(t);
+    }
     for m in &g.materials {
         let name = (m.index.is_some() || !has_default_material).then(|| m.name.clone());
         if name.is_some() {
+            let texture = m.texture.map(|mut t| {
+                t.texture += texture_base;
+                t
+            });
             let def = MtlDef {
                 kd: Some(m.diffuse.into()),
                 ks: Some(m.mirror.into()),
                 illum: Some(3),
                 at: Location::file(&file),
                 gltf: true,
+                texture: texture.map_or(DefTexture::None, DefTexture::Ready),
+                vertex_colors: m.vertex_colors,
+                alpha: m.alpha,
             };
             match mtl.defs.get(&m.name) {
                 Some(old) if old.diffuse() != def.diffuse() || old.mirror() != def.mirror() => {
@@ -481,10 +563,17 @@ fn add_gltf(
             missing_mtl: Vec::new(),
         });
     }
-    triangles.extend(g.triangles.into_iter().map(|mut t| {
-        t.material += slot_base as u32;
-        t
-    }));
+    if !g.attributes.is_empty() {
+        let before = geometry.triangles.len();
+        geometry.attributes.resize(before, TriAttributes::NONE);
+        geometry.attributes.extend_from_slice(&g.attributes);
+    }
+    geometry
+        .triangles
+        .extend(g.triangles.into_iter().map(|mut t| {
+            t.material += slot_base as u32;
+            t
+        }));
 }
 
 #[cfg(test)]

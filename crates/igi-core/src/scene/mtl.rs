@@ -1,6 +1,9 @@
 //! MTL material libraries and the resolution of a material name: an MTL (or glTF)
 //! definition with `[materials.NAME]` of the scene file laid over it key by key, checked
-//! to be a valid albedo. MTL text is checked line by line before tobj reads it.
+//! to be a valid albedo, with its texture (MTL maps are read in `maps` when a face first
+//! uses them) and alpha. MTL text is checked line by line before tobj reads it.
+
+pub(super) mod maps;
 
 use std::collections::{BTreeMap, HashMap, HashSet};
 use std::panic::{catch_unwind, AssertUnwindSafe};
@@ -10,9 +13,16 @@ use glam::Vec3;
 use toml::Spanned;
 
 use super::error::{as_lenient_text, excerpt, fmt3, quote, Location, SceneError, CHANNELS};
+use super::loader::settled_alpha;
 use super::obj::{strip_comments, Slot};
 use super::toml_file::{MaterialDesc, TomlFile, V3};
-use super::Material;
+use super::{Alpha, AlphaMode, Material};
+use crate::texture::TextureRef;
+use maps::{parse_map, Maps, Textures};
+
+/// The cutoff of MTL materials that `d` or `map_d` makes partly transparent: drawn as
+/// cut-outs (the renderer does not blend).
+pub(super) const MTL_ALPHA_CUTOFF: f32 = 0.5;
 
 /// Slack allowed on `diffuse + mirror <= 1` (per channel), for values written with few
 /// digits such as 0.35 + 0.65.
@@ -24,6 +34,17 @@ pub(super) struct MtlTable {
     pub(super) defs: HashMap<String, MtlDef>,
     /// MTL files already read (a file named by several meshes is read once).
     pub(super) read: HashSet<PathBuf>,
+    /// The scene's textures: glTF files' as they are read, MTL maps on first use.
+    pub(super) textures: Textures,
+}
+
+/// A definition's base colour texture.
+pub(super) enum DefTexture {
+    None,
+    /// In the table's textures (a glTF texture, or MTL maps once read).
+    Ready(TextureRef),
+    /// MTL `map_Kd` and `map_d`, read when a face first uses the material.
+    Maps(Maps),
 }
 
 pub(super) struct MtlDef {
@@ -34,11 +55,24 @@ pub(super) struct MtlDef {
     pub(super) at: Location,
     /// Made from a glTF material (glTF hook): `kd`/`ks` are its diffuse/mirror, `illum` 3.
     pub(super) gltf: bool,
+    pub(super) texture: DefTexture,
+    pub(super) vertex_colors: bool,
+    /// glTF: the material's; MTL: a cut-out at [`MTL_ALPHA_CUTOFF`] of opacity `d` (`1 -
+    /// Tr`) where that is below 1 or there is a `map_d`, otherwise opaque.
+    pub(super) alpha: Alpha,
 }
 
 impl MtlDef {
+    /// `Kd`; with a `map_Kd` and no `Kd`, 1 (the texture alone), else 0.
     pub(super) fn diffuse(&self) -> [f32; 3] {
-        self.kd.unwrap_or([0.0; 3])
+        let textured = matches!(&self.texture, DefTexture::Maps(m) if m.kd.is_some());
+        self.kd
+            .unwrap_or(if textured { [1.0; 3] } else { [0.0; 3] })
+    }
+
+    /// Whether its faces need texture coordinates (decided before its maps are read).
+    pub(super) fn textured(&self) -> bool {
+        !matches!(self.texture, DefTexture::None)
     }
 
     /// `Ks` is a perfect mirror only for the ray-traced illumination models 3, 5 and 7.
@@ -59,14 +93,30 @@ pub(super) struct Sourced {
 }
 
 /// The material `name`: the MTL's values replaced key by key by `[materials.NAME]`.
-/// `Ok(None)` when neither defines it.
+/// `Ok(None)` when neither defines it. Its MTL maps are read (once) when `for_faces`: a
+/// face uses it; otherwise it is only checked.
+///
+/// The texture and vertex colours of the definition are kept unless `[materials.NAME]`
+/// sets `diffuse` or `mirror` (a constant colour replaces them); `texture = false` there
+/// replaces the texture by its mean colour (the factors times it) and makes the material
+/// opaque.
 pub(super) fn resolve_material(
     tf: &TomlFile,
     name: &str,
     toml_mats: &BTreeMap<String, Spanned<MaterialDesc>>,
-    mtl: &MtlTable,
+    mtl: &mut MtlTable,
+    for_faces: bool,
 ) -> Result<Option<Material>, SceneError> {
     let over = toml_mats.get(name);
+    let toml_d = over.and_then(|o| o.get_ref().diffuse.as_ref());
+    let toml_m = over.and_then(|o| o.get_ref().mirror.as_ref());
+    // A colour set in the scene file replaces the texture and the vertex colours.
+    let constant = toml_d.is_some() || toml_m.is_some();
+    let texture = if for_faces && !constant {
+        texture_of(mtl, name)
+    } else {
+        None
+    };
     let base = mtl.defs.get(name);
     if over.is_none() && base.is_none() {
         return Ok(None);
@@ -98,8 +148,6 @@ pub(super) fn resolve_material(
             }
         }
     };
-    let toml_d = over.and_then(|o| o.get_ref().diffuse.as_ref());
-    let toml_m = over.and_then(|o| o.get_ref().mirror.as_ref());
     let diffuse = pick(
         "diffuse",
         toml_d,
@@ -169,13 +217,60 @@ pub(super) fn resolve_material(
             ));
         }
     }
-    Ok(Some(Material::new(
+    let mut m = Material::new(
         full_name,
         Vec3::from(diffuse.value),
         Vec3::from(mirror.value),
-    )))
+    );
+    if let Some(b) = base {
+        m.alpha = b.alpha;
+        if !constant {
+            m.vertex_colors = b.vertex_colors;
+        }
+    }
+    m.texture = texture;
+    if over
+        .and_then(|o| o.get_ref().texture.as_ref())
+        .is_some_and(|t| !*t.get_ref())
+    {
+        match m.texture.take() {
+            Some(t) => {
+                let mean = mtl.textures.list[t.texture as usize].mean().truncate();
+                m.diffuse *= mean;
+                m.mirror *= mean;
+            }
+            None if for_faces && !constant => log::warn!(
+                "{}: [materials.{name}] texture = false, but material '{name}' has no texture",
+                tf.name
+            ),
+            None => {}
+        }
+        m.alpha = Alpha::OPAQUE;
+    }
+    m.alpha = settled_alpha(m.alpha, m.texture.is_some(), m.vertex_colors);
+    Ok(Some(m))
 }
 
+/// The texture of definition `name`, its MTL maps read on first use and kept as read
+/// (so that their warnings are given once). A `map_d` that cannot be used makes no
+/// cut-out: then `d` alone decides the alpha.
+fn texture_of(mtl: &mut MtlTable, name: &str) -> Option<TextureRef> {
+    let def = mtl.defs.get_mut(name)?;
+    match &def.texture {
+        DefTexture::None => None,
+        DefTexture::Ready(t) => Some(*t),
+        DefTexture::Maps(maps) => {
+            let made = mtl.textures.maps(maps, name);
+            let with_d = made.is_some_and(|(_, with_d)| with_d);
+            if maps.d.is_some() && !with_d && def.alpha.factor >= 1.0 {
+                def.alpha = Alpha::OPAQUE;
+            }
+            let t = made.map(|(t, _)| t);
+            def.texture = t.map_or(DefTexture::None, DefTexture::Ready);
+            t
+        }
+    }
+}
 pub(super) fn undefined_material(
     tf: &TomlFile,
     name: &str,
@@ -211,7 +306,9 @@ pub(super) fn read_mtl(bytes: &[u8], path: &Path, table: &mut MtlTable) -> Resul
     let text = as_lenient_text(bytes, &file)?;
     let text = strip_comments(text.as_ref());
     let text = text.as_ref();
-    let newmtl_lines = check_mtl(text, &file)?;
+    let lines = check_mtl(text, &file)?;
+    let dir = path.parent().unwrap_or(Path::new(""));
+    let mut partly_transparent = 0usize;
     let loaded = catch_unwind(AssertUnwindSafe(|| {
         tobj::load_mtl_buf(&mut text.as_bytes())
     }));
@@ -235,12 +332,47 @@ pub(super) fn read_mtl(bytes: &[u8], path: &Path, table: &mut MtlTable) -> Resul
         if map.get(&m.name) != Some(&i) {
             continue;
         }
+        let at_line =
+            |f: fn(&MtlLines) -> usize| Location::line(&file, lines.get(&m.name).map_or(1, f));
+        let maps = Maps {
+            kd: m
+                .diffuse_texture
+                .as_ref()
+                .map(|a| parse_map(a, dir, at_line(|l| l.map_kd))),
+            d: m.dissolve_texture
+                .as_ref()
+                .map(|a| parse_map(a, dir, at_line(|l| l.map_d))),
+        };
+        // `d` is the opacity, `Tr` (transparency) its complement; `d` where both are given.
+        let tr = m
+            .unknown_param
+            .get("Tr")
+            .and_then(|t| t.parse::<f32>().ok());
+        let opacity = m.dissolve.or(tr.map(|t| 1.0 - t)).unwrap_or(1.0);
+        let alpha = if opacity < 1.0 || maps.d.is_some() {
+            partly_transparent += 1;
+            Alpha {
+                mode: AlphaMode::Mask {
+                    cutoff: MTL_ALPHA_CUTOFF,
+                },
+                factor: opacity,
+            }
+        } else {
+            Alpha::OPAQUE
+        };
         let def = MtlDef {
             kd: m.diffuse,
             ks: m.specular,
             illum: m.illumination_model,
-            at: Location::line(&file, newmtl_lines.get(&m.name).copied().unwrap_or(1)),
+            at: at_line(|l| l.newmtl),
             gltf: false,
+            texture: if maps.kd.is_some() || maps.d.is_some() {
+                DefTexture::Maps(maps)
+            } else {
+                DefTexture::None
+            },
+            vertex_colors: false,
+            alpha,
         };
         match table.defs.get(&m.name) {
             Some(old) => {
@@ -258,14 +390,29 @@ pub(super) fn read_mtl(bytes: &[u8], path: &Path, table: &mut MtlTable) -> Resul
             }
         }
     }
+    if partly_transparent > 0 {
+        log::warn!(
+            "{file}: {partly_transparent} materials with d (or Tr) below 1 or a map_d: partial transparency is drawn as a cut-out at opacity {MTL_ALPHA_CUTOFF} (igi does not blend: a point is there where its opacity is at least {MTL_ALPHA_CUTOFF}, and cut out elsewhere)"
+        );
+    }
     Ok(())
 }
 
+/// Where a material's lines are in its MTL file (of its last definition there).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(super) struct MtlLines {
+    pub(super) newmtl: usize,
+    pub(super) map_kd: usize,
+    pub(super) map_d: usize,
+}
+
 /// Checks the MTL lines that `tobj::load_mtl_buf` parses strictly, so that its errors come
-/// with a line number and its panic (a colour of fewer than three numbers) cannot happen.
-/// Returns the line of each `newmtl` (the last one for a repeated name).
-pub(super) fn check_mtl(text: &str, file: &str) -> Result<HashMap<String, usize>, SceneError> {
-    let mut newmtl = HashMap::new();
+/// with a line number and its panic (a colour of fewer than three numbers) cannot happen;
+/// and the opacities igi reads (`d`, `Tr`), which must lie in [0, 1]. Returns the lines of
+/// each material (of the last definition of a repeated name).
+pub(super) fn check_mtl(text: &str, file: &str) -> Result<HashMap<String, MtlLines>, SceneError> {
+    let mut newmtl: HashMap<String, MtlLines> = HashMap::new();
+    let mut current: Option<String> = None;
     for (i, raw) in text.lines().enumerate() {
         let ln = i + 1;
         let line = raw.trim();
@@ -282,25 +429,49 @@ pub(super) fn check_mtl(text: &str, file: &str) -> Result<HashMap<String, usize>
             "newmtl" => {
                 let name = line.get(6..).unwrap_or("").trim();
                 if !name.is_empty() {
-                    newmtl.insert(name.to_string(), ln);
+                    let lines = MtlLines {
+                        newmtl: ln,
+                        ..MtlLines::default()
+                    };
+                    newmtl.insert(name.to_string(), lines);
+                    current = Some(name.to_string());
                 }
                 name.is_empty()
                     .then(|| "newmtl without a material name".to_string())
             }
             "Ka" | "Kd" | "Ks" | "Ke" => (!(0..3).all(|_| number(words.next())))
                 .then(|| format!("{key} needs three numbers (r g b)")),
-            "Ns" | "Ni" | "d" => (!number(words.next())).then(|| format!("{key} needs a number")),
+            "Ns" | "Ni" => (!number(words.next())).then(|| format!("{key} needs a number")),
+            "d" | "Tr" => match words.next().map(|w| w.parse::<f32>()) {
+                Some(Ok(x)) if (0.0..=1.0).contains(&x) => None,
+                Some(Ok(_)) => Some(format!(
+                    "{key} must be in [0, 1] ({}: 1 is opaque, 0 invisible)",
+                    if key == "d" {
+                        "opacity"
+                    } else {
+                        "transparency, 1 - d: 0 is opaque"
+                    }
+                )),
+                _ => Some(format!("{key} needs a number")),
+            },
             "illum" => words
                 .next()
                 .is_none_or(|w| w.parse::<u8>().is_err())
                 .then(|| "illum needs an integer from 0 to 10".to_string()),
             "map_Ka" | "map_Kd" | "map_Ks" | "map_Bump" | "map_bump" | "map_Ns" | "map_ns"
-            | "map_NS" | "bump" | "map_d" => line
-                .get(key.len()..)
-                .unwrap_or("")
-                .trim()
-                .is_empty()
-                .then(|| format!("{key} without a file name")),
+            | "map_NS" | "bump" | "map_d" => {
+                let at = current.as_ref().and_then(|c| newmtl.get_mut(c));
+                match (key, at) {
+                    ("map_Kd", Some(l)) => l.map_kd = ln,
+                    ("map_d", Some(l)) => l.map_d = ln,
+                    _ => {}
+                }
+                line.get(key.len()..)
+                    .unwrap_or("")
+                    .trim()
+                    .is_empty()
+                    .then(|| format!("{key} without a file name"))
+            }
             _ => None,
         };
         if let Some(problem) = problem {

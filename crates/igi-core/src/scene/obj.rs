@@ -1,6 +1,8 @@
 //! Wavefront OBJ meshes: our own pass over the text (`scan_obj`, for line numbers and the
 //! cases tobj gets wrong, see the loader's module documentation), then tobj, then the
-//! triangles and their material slots as the loader merges them.
+//! triangles and their material slots as the loader merges them, with the texture
+//! coordinates (`vt`, as v' = 1 - v: glTF's convention) of the faces whose material has
+//! a texture.
 
 use std::borrow::Cow;
 use std::collections::HashMap;
@@ -8,12 +10,12 @@ use std::io::{self, Read};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
 
-use glam::Vec3;
+use glam::{Vec2, Vec3, Vec4};
 
 use super::error::{as_lenient_text, excerpt, io_message, quote, quote_path, Location, SceneError};
-use super::loader::{read_regular_file, TriangleBudget};
+use super::loader::{read_regular_file, Geometry, TriangleBudget};
 use super::mtl::{read_mtl, MtlTable};
-use super::Triangle;
+use super::{TriAttributes, Triangle};
 
 /// The OBJ or MTL text without its comments: a `#` at the start of a line or after
 /// white space begins a comment to the end of the line (`f 1 2 3 # face`). Lines keep
@@ -62,6 +64,8 @@ pub(super) struct Slot {
 pub(super) const TRI_POLYLINE: u8 = 1;
 /// Every corner of the face the triangle came from has a `vn` index.
 pub(super) const TRI_HAS_VN: u8 = 2;
+/// Every corner of the face the triangle came from has a `vt` index.
+pub(super) const TRI_HAS_VT: u8 = 4;
 
 /// What [`scan_obj`] learns from an OBJ's text.
 #[derive(Debug, Default)]
@@ -120,7 +124,7 @@ pub(super) fn scan_obj<'a>(text: &'a str, file: &str) -> Result<ObjScan<'a>, Sce
             _ if first_error.is_some() => {}
             "f" | "l" => match scan_face(words, &s.counts, &mut forward, ln) {
                 Err(e) => first_error = Some((ln, e)),
-                Ok((corners, all_vn)) => {
+                Ok((corners, all_vt, all_vn)) => {
                     if corners < 3 {
                         if corners == 0 {
                             first_error = Some((ln, format!("'{key}' line without vertices")));
@@ -130,6 +134,9 @@ pub(super) fn scan_obj<'a>(text: &'a str, file: &str) -> Result<ObjScan<'a>, Sce
                         continue;
                     }
                     let mut flag = if all_vn { TRI_HAS_VN } else { 0 };
+                    if all_vt {
+                        flag |= TRI_HAS_VT;
+                    }
                     if key == "l" {
                         flag |= TRI_POLYLINE;
                     } else if !tagged && s.untagged_line.is_none() {
@@ -199,14 +206,16 @@ pub(super) fn scan_obj<'a>(text: &'a str, file: &str) -> Result<ObjScan<'a>, Sce
 
 /// Parses the corners of one `f` line exactly as tobj does (`v`, `v/vt`, `v//vn`,
 /// `v/vt/vn`, negative indices relative to the count so far) and checks every index.
-/// Returns the number of corners and whether all have a normal index.
+/// Returns the number of corners and whether all have a texture coordinate index, and a
+/// normal index.
 pub(super) fn scan_face<'a>(
     corners: impl Iterator<Item = &'a str>,
     counts: &[usize; 3],
     forward: &mut Forward,
     ln: usize,
-) -> Result<(usize, bool), String> {
+) -> Result<(usize, bool, bool), String> {
     let mut n = 0;
+    let mut all_vt = true;
     let mut all_vn = true;
     for corner in corners {
         n += 1;
@@ -262,9 +271,10 @@ pub(super) fn scan_face<'a>(
                 quote(corner)
             ));
         }
+        all_vt &= has[1];
         all_vn &= has[2];
     }
-    Ok((n, all_vn))
+    Ok((n, all_vt, all_vn))
 }
 
 /// The path tobj is given (as its first `mtllib` line) to learn every `usemtl` name.
@@ -272,14 +282,17 @@ pub(super) const NAMES_MTLLIB: &str = "\u{1}igi-usemtl-names";
 
 /// Reads one OBJ: appends its triangles (material = slot index) and its slots; reads its
 /// MTL files into `mtl`. Its faces must fit in `budget` (counted before tobj reads them).
+/// The triangles of a material that has a texture (by the MTL files read so far; faces
+/// without `usemtl` by `default_material`) get their texture coordinates.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn load_obj(
     bytes: &[u8],
     path: &Path,
     mesh: usize,
+    default_material: Option<&str>,
     budget: TriangleBudget,
     slots: &mut Vec<Slot>,
-    out: &mut Vec<Triangle>,
+    out: &mut Geometry,
     mtl: &mut MtlTable,
     files: &mut Vec<PathBuf>,
 ) -> Result<(), SceneError> {
@@ -402,10 +415,20 @@ pub(super) fn load_obj(
             format!("internal error reading the OBJ: {what}"),
         )
     };
+    // Per slot: whether its material has a texture, so that its triangles need their `vt`.
+    let textured: Vec<bool> = (0..=n_keys)
+        .map(|k| {
+            let name = scan.names.get(k).map(|n| n.as_ref()).or(default_material);
+            name.and_then(|n| mtl.defs.get(n))
+                .is_some_and(|d| d.textured())
+        })
+        .collect();
     let mut g = 0; // triangle number in file order, indexes scan.flags
     let mut degenerate = 0usize;
     let mut bad_normals = 0usize;
-    out.reserve(scan.flags.len());
+    let mut without_vt = 0usize;
+    let mut bad_vt = 0usize;
+    out.triangles.reserve(scan.flags.len());
     for model in &models {
         let m = &model.mesh;
         let slot = match m.material_id {
@@ -421,6 +444,11 @@ pub(super) fn load_obj(
         let nrm = |i: u32| -> Option<Vec3> {
             let i = i as usize * 3;
             m.normals.get(i..i + 3).map(Vec3::from_slice)
+        };
+        let has_texcoords = !m.texcoords.is_empty() && m.texcoord_indices.len() == m.indices.len();
+        let tex = |i: u32| -> Option<Vec2> {
+            let i = i as usize * 2;
+            m.texcoords.get(i..i + 2).map(Vec2::from_slice)
         };
         for (t, idx) in m.indices.chunks_exact(3).enumerate() {
             let Some(&flag) = scan.flags.get(g) else {
@@ -451,11 +479,33 @@ pub(super) fn load_obj(
                     }
                 }
             }
-            out.push(Triangle {
-                v,
-                n,
-                material: (slot_base + slot) as u32,
+            let attributes = textured[slot].then(|| {
+                let mut uv = [Vec2::ZERO; 3];
+                if has_texcoords && flag & TRI_HAS_VT != 0 {
+                    for (k, uk) in uv.iter_mut().enumerate() {
+                        let vt = m.texcoord_indices.get(3 * t + k).and_then(|&i| tex(i));
+                        match vt {
+                            // MTL's v grows upwards, the renderer's (glTF's) downwards.
+                            Some(x) if x.is_finite() => *uk = Vec2::new(x.x, 1.0 - x.y),
+                            _ => bad_vt += 1,
+                        }
+                    }
+                } else {
+                    without_vt += 1;
+                }
+                TriAttributes {
+                    uv,
+                    color: [Vec4::ONE; 3],
+                }
             });
+            out.push(
+                Triangle {
+                    v,
+                    n,
+                    material: (slot_base + slot) as u32,
+                },
+                attributes,
+            );
             slots[slot_base + slot].triangles += 1;
         }
     }
@@ -471,6 +521,14 @@ pub(super) fn load_obj(
         log::warn!(
             "{file}: {bad_normals} vn normals of zero length or not finite replaced by the geometric normal"
         );
+    }
+    if without_vt > 0 {
+        log::warn!(
+            "{file}: {without_vt} triangles of textured materials have no texture coordinates (vt): they are drawn with the texel at (0, 0)"
+        );
+    }
+    if bad_vt > 0 {
+        log::warn!("{file}: {bad_vt} texture coordinates (vt) that are not finite made 0");
     }
     let polylines = scan
         .flags
@@ -609,6 +667,8 @@ mod tests {
         assert_eq!(s.keys, ["m"]);
         assert_eq!(s.small_faces, 1);
         assert_eq!(s.counts, [4, 0, 1]);
+        let s = scan_obj("v 0 0 0\nvt 0 0\nf 1/1 1/1 1/1\nf 1/1 1 1\n", "t.obj").unwrap();
+        assert_eq!(s.flags, [TRI_HAS_VT, 0]);
     }
 
     #[test]

@@ -118,6 +118,8 @@ pub(super) struct LightDesc {
 pub(super) struct MaterialDesc {
     pub(super) diffuse: Option<V3>,
     pub(super) mirror: Option<V3>,
+    /// `false`: the texture replaced by its mean colour, and the material made opaque.
+    pub(super) texture: Option<Spanned<bool>>,
 }
 
 /// The TOML text and its name, to turn spans into locations.

@@ -1,13 +1,14 @@
 //! The reader's state ([`Reader`]), its buffers (GLB chunk, `data:` URIs and files), the
 //! checks of buffer views and accessors that the gltf crate's readers assume, and the
-//! reading of each accessor, once however many primitives use it.
+//! reading of each accessor, once however many primitives use it: floats, or the integers
+//! of KHR_mesh_quantization turned into the values they stand for ([`Components`]).
 
 use std::collections::HashMap;
 use std::path::PathBuf;
 use std::rc::Rc;
 
-use ::gltf::accessor::{DataType, Dimensions, Iter};
-use glam::Vec3;
+use ::gltf::accessor::{DataType, Dimensions, Item, Iter};
+use glam::{Vec2, Vec3, Vec4};
 
 use super::document::{percent_decode, Warnings};
 use super::materials::ImageSource;
@@ -26,8 +27,11 @@ pub(super) struct Reader {
     pub(super) out: GltfMesh,
     /// glTF material index (`None`: default material) -> index in `out.materials`.
     pub(super) materials: HashMap<Option<usize>, usize>,
-    /// Image index -> average linear colour (`None`: could not be decoded).
-    pub(super) textures: HashMap<usize, Option<Vec3>>,
+    /// Per entry of `out.materials`: the texture coordinate set its base colour texture
+    /// reads (`None`: no texture), so that primitives read that TEXCOORD_n.
+    pub(super) uv_sets: Vec<Option<u32>>,
+    /// Image index -> index in `out.textures` (`None`: could not be decoded).
+    pub(super) textures: HashMap<usize, Option<u32>>,
     /// Images whose `Image::source()` would panic in the gltf crate (found by fuzzing:
     /// neither `uri` nor `bufferView`, or a `bufferView` without `mimeType`), with why.
     pub(super) bad_images: HashMap<usize, &'static str>,
@@ -43,11 +47,15 @@ pub(super) struct Reader {
 /// one mesh reads its data once, and only its triangles are made per node.
 #[derive(Default)]
 pub(super) struct Shared {
-    pub(super) vec3s: HashMap<usize, Rc<[Vec3]>>,
+    /// By accessor index and the [`Components`] it was read as (which types it may have).
+    pub(super) vec2s: HashMap<(usize, &'static str), Rc<[Vec2]>>,
+    pub(super) vec3s: HashMap<(usize, &'static str), Rc<[Vec3]>>,
+    pub(super) vec4s: HashMap<(usize, &'static str), Rc<[Vec4]>>,
     pub(super) indices: HashMap<usize, Rc<[u32]>>,
     /// `None`: a primitive of mode POINTS or LINES*, skipped.
     pub(super) primitives: HashMap<(usize, usize), Option<Rc<Prepared>>>,
-    pub(super) images: HashMap<ImageSource, Option<Vec3>>,
+    /// Image source -> index in `out.textures` (`None`: could not be decoded).
+    pub(super) images: HashMap<ImageSource, Option<u32>>,
     /// Elements of accessors without a buffer view read so far (see
     /// [`MAX_VIEWLESS_ELEMENTS`]).
     pub(super) viewless: usize,
@@ -59,6 +67,89 @@ pub(super) struct Shared {
 pub(super) struct ReadStats {
     pub(super) accessors_read: usize,
     pub(super) images_decoded: usize,
+}
+
+/// The component types an attribute may have: FLOAT, and the integer types of glTF 2.0
+/// and KHR_mesh_quantization (which gltfpack writes by default), each read as the value it
+/// stands for. The gltf crate's own readers (`read_positions`...) take floats only.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Components {
+    /// Names the rule in caches and messages.
+    pub(super) name: &'static str,
+    /// Integer types that may be normalized: read as c / MAX, and for signed types
+    /// max(c / MAX, -1), as the glTF specification says.
+    pub(super) normalized: &'static [DataType],
+    /// Integer types that may be read as their plain values.
+    pub(super) plain: &'static [DataType],
+}
+
+const ALL_INTS: &[DataType] = &[DataType::I8, DataType::U8, DataType::I16, DataType::U16];
+
+/// POSITION (and instance TRANSLATION and SCALE): with KHR_mesh_quantization, bytes and
+/// shorts, signed or not, normalized or not.
+pub(super) const POSITIONS: Components = Components {
+    name: "positions",
+    normalized: ALL_INTS,
+    plain: ALL_INTS,
+};
+
+/// NORMAL: with KHR_mesh_quantization, normalized signed bytes and shorts.
+pub(super) const NORMALS: Components = Components {
+    name: "normals",
+    normalized: &[DataType::I8, DataType::I16],
+    plain: &[],
+};
+
+/// TEXCOORD_n: normalized unsigned bytes and shorts (glTF 2.0); with KHR_mesh_quantization
+/// also signed ones, and plain integers of all four.
+pub(super) const TEXCOORDS: Components = Components {
+    name: "texcoords",
+    normalized: ALL_INTS,
+    plain: ALL_INTS,
+};
+
+/// COLOR_n: normalized unsigned bytes and shorts (glTF 2.0).
+pub(super) const COLORS: Components = Components {
+    name: "colors",
+    normalized: &[DataType::U8, DataType::U16],
+    plain: &[],
+};
+
+/// An accessor's elements of `N` components as f32, integers converted as `normalized`
+/// says (the caller checked the type, so the gltf crate's reader sees the size it expects).
+fn convert<'a, 's, const N: usize>(
+    acc: &::gltf::Accessor<'a>,
+    data: impl Clone + Fn(::gltf::Buffer<'a>) -> Option<&'s [u8]>,
+    normalized: bool,
+) -> Option<Vec<[f32; N]>>
+where
+    [f32; N]: Item,
+    [i8; N]: Item,
+    [u8; N]: Item,
+    [i16; N]: Item,
+    [u16; N]: Item,
+{
+    fn read<'a, 's, T: Copy, const N: usize>(
+        acc: &::gltf::Accessor<'a>,
+        data: impl Clone + Fn(::gltf::Buffer<'a>) -> Option<&'s [u8]>,
+        f: impl Fn(T) -> f32,
+    ) -> Option<Vec<[f32; N]>>
+    where
+        [T; N]: Item,
+    {
+        Iter::<[T; N]>::new(acc.clone(), data).map(|i| i.map(|e| e.map(&f)).collect())
+    }
+    match (acc.data_type(), normalized) {
+        (DataType::I8, true) => read(acc, data, |c: i8| (c as f32 / 127.0).max(-1.0)),
+        (DataType::U8, true) => read(acc, data, |c: u8| c as f32 / 255.0),
+        (DataType::I16, true) => read(acc, data, |c: i16| (c as f32 / 32767.0).max(-1.0)),
+        (DataType::U16, true) => read(acc, data, |c: u16| c as f32 / 65535.0),
+        (DataType::I8, false) => read(acc, data, |c: i8| c as f32),
+        (DataType::U8, false) => read(acc, data, |c: u8| c as f32),
+        (DataType::I16, false) => read(acc, data, |c: i16| c as f32),
+        (DataType::U16, false) => read(acc, data, |c: u16| c as f32),
+        _ => read(acc, data, |c: f32| c),
+    }
 }
 
 impl Reader {
@@ -203,26 +294,27 @@ impl Reader {
         Ok(())
     }
 
-    /// Checks what the gltf crate's reader of `acc` assumes: its type (the reader asserts
-    /// the element size), a count of at least 1 (it computes `count - 1`), its byte
-    /// ranges, and those of its sparse part.
+    /// Checks what the gltf crate's reader of `acc` assumes: its type (one of `dims` of one
+    /// of `types`: the reader asserts the element size), a count of at least 1 (it computes
+    /// `count - 1`), its byte ranges, and those of its sparse part.
     pub(super) fn check_accessor(
         &self,
         acc: &::gltf::Accessor,
         what: &str,
         types: &[DataType],
-        dims: Dimensions,
+        dims: &[Dimensions],
     ) -> Result<(), SceneError> {
         let label = format!("{what} (accessor {})", acc.index());
-        if !types.contains(&acc.data_type()) || acc.dimensions() != dims {
-            let expected: Vec<String> = types.iter().map(|t| format!("{t:?}")).collect();
+        if !types.contains(&acc.data_type()) || !dims.contains(&acc.dimensions()) {
+            let list = |v: Vec<String>| v.join(" or ");
             return Err(parse(
                 &self.file,
                 format!(
-                    "{label} is {:?} of {:?}; expected {dims:?} of {}",
+                    "{label} is {:?} of {:?}; expected {} of {}",
                     acc.dimensions(),
                     acc.data_type(),
-                    expected.join(" or ")
+                    list(dims.iter().map(|d| format!("{d:?}")).collect()),
+                    list(types.iter().map(|t| format!("{t:?}")).collect()),
                 ),
             ));
         }
@@ -334,25 +426,127 @@ impl Reader {
         Ok(())
     }
 
-    /// The elements of a VEC3 FLOAT accessor (POSITION, NORMAL), checked and read on first
-    /// use; `what` names it in messages ("mesh 0 primitive 1 POSITION").
+    /// The elements of an accessor of `N` components (one of `dims`) as f32, of a component
+    /// type that `components` allows, integers converted to the values they stand for;
+    /// `what` names it in messages ("mesh 0 primitive 1 POSITION").
+    fn floats<const N: usize>(
+        &mut self,
+        acc: &::gltf::Accessor,
+        what: &str,
+        components: Components,
+        dims: &[Dimensions],
+    ) -> Result<Vec<[f32; N]>, SceneError>
+    where
+        [f32; N]: Item,
+        [i8; N]: Item,
+        [u8; N]: Item,
+        [i16; N]: Item,
+        [u16; N]: Item,
+    {
+        let mut types = vec![DataType::F32];
+        for t in components.normalized.iter().chain(components.plain) {
+            if !types.contains(t) {
+                types.push(*t);
+            }
+        }
+        self.check_accessor(acc, what, &types, dims)?;
+        let ty = acc.data_type();
+        // FLOAT ignores `normalized` (which the spec does not allow on it).
+        let normalized = ty != DataType::F32 && acc.normalized();
+        let allowed = match normalized {
+            _ if ty == DataType::F32 => true,
+            true => components.normalized.contains(&ty),
+            false => components.plain.contains(&ty),
+        };
+        if !allowed {
+            let how = if normalized {
+                "may not be normalized"
+            } else {
+                "must be normalized"
+            };
+            return Err(parse(
+                &self.file,
+                format!(
+                    "{what} (accessor {}): {ty:?} components {how} here (glTF 2.0 and KHR_mesh_quantization)",
+                    acc.index()
+                ),
+            ));
+        }
+        let buffers = &self.buffers;
+        let data = |b: ::gltf::Buffer| buffers.get(b.index()).map(|d| d.0.as_slice());
+        let values =
+            convert::<N>(acc, data, normalized).ok_or_else(|| self.unreadable(acc, what))?;
+        self.read_once(acc);
+        Ok(values)
+    }
+
+    /// The elements of a VEC3 accessor (POSITION, NORMAL, instance TRANSLATION and SCALE)
+    /// of the types `components` allows, checked and read on first use; `what` names it in
+    /// messages ("mesh 0 primitive 1 POSITION").
     pub(super) fn vec3s(
         &mut self,
         acc: &::gltf::Accessor,
         what: &str,
+        components: Components,
     ) -> Result<Rc<[Vec3]>, SceneError> {
-        if let Some(v) = self.shared.vec3s.get(&acc.index()) {
+        let key = (acc.index(), components.name);
+        if let Some(v) = self.shared.vec3s.get(&key) {
             return Ok(v.clone());
         }
-        self.check_accessor(acc, what, &[DataType::F32], Dimensions::Vec3)?;
-        let buffers = &self.buffers;
-        let data = |b: ::gltf::Buffer| buffers.get(b.index()).map(|d| d.0.as_slice());
-        let values: Rc<[Vec3]> = Iter::<[f32; 3]>::new(acc.clone(), data)
-            .ok_or_else(|| self.unreadable(acc, what))?
+        let values: Rc<[Vec3]> = self
+            .floats::<3>(acc, what, components, &[Dimensions::Vec3])?
+            .into_iter()
             .map(Vec3::from)
             .collect();
-        self.read_once(acc);
-        self.shared.vec3s.insert(acc.index(), values.clone());
+        self.shared.vec3s.insert(key, values.clone());
+        Ok(values)
+    }
+
+    /// The elements of a VEC2 accessor (TEXCOORD_n), as [`Self::vec3s`].
+    pub(super) fn vec2s(
+        &mut self,
+        acc: &::gltf::Accessor,
+        what: &str,
+        components: Components,
+    ) -> Result<Rc<[Vec2]>, SceneError> {
+        let key = (acc.index(), components.name);
+        if let Some(v) = self.shared.vec2s.get(&key) {
+            return Ok(v.clone());
+        }
+        let values: Rc<[Vec2]> = self
+            .floats::<2>(acc, what, components, &[Dimensions::Vec2])?
+            .into_iter()
+            .map(Vec2::from)
+            .collect();
+        self.shared.vec2s.insert(key, values.clone());
+        Ok(values)
+    }
+
+    /// The elements of a VEC3 or VEC4 accessor (COLOR_n) as RGBA (alpha 1 for VEC3), as
+    /// [`Self::vec3s`].
+    pub(super) fn colors(
+        &mut self,
+        acc: &::gltf::Accessor,
+        what: &str,
+        components: Components,
+    ) -> Result<Rc<[Vec4]>, SceneError> {
+        let key = (acc.index(), components.name);
+        if let Some(v) = self.shared.vec4s.get(&key) {
+            return Ok(v.clone());
+        }
+        let dims = [Dimensions::Vec3, Dimensions::Vec4];
+        let values: Rc<[Vec4]> = if acc.dimensions() == Dimensions::Vec3 {
+            self.floats::<3>(acc, what, components, &dims)?
+                .into_iter()
+                .map(|c| Vec3::from(c).extend(1.0))
+                .collect()
+        } else {
+            self.floats::<4>(acc, what, components, &dims)?
+                .into_iter()
+                .map(Vec4::from)
+                .collect()
+        };
+        self.shared.vec4s.insert(key, values.clone());
         Ok(values)
     }
 
@@ -366,7 +560,7 @@ impl Reader {
             return Ok(v.clone());
         }
         let types = [DataType::U8, DataType::U16, DataType::U32];
-        self.check_accessor(acc, what, &types, Dimensions::Scalar)?;
+        self.check_accessor(acc, what, &types, &[Dimensions::Scalar])?;
         let buffers = &self.buffers;
         let data = |b: ::gltf::Buffer| buffers.get(b.index()).map(|d| d.0.as_slice());
         let values: Option<Rc<[u32]>> = match acc.data_type() {

@@ -13,7 +13,8 @@ use super::accessors::{ReadStats, Reader, Shared};
 use super::messages::{document_error, invalid, parse};
 use super::GltfMesh;
 use crate::scene::error::quote;
-use crate::scene::loader::{SceneError, TriangleBudget};
+use crate::scene::loader::{settled_alpha, SceneError, TriangleBudget};
+use crate::scene::TriAttributes;
 
 /// Decodes `%XX` escapes of a relative URI. `None` when the result is not UTF-8 (the gltf
 /// crate would panic on such a URI, so it never sees one).
@@ -79,10 +80,15 @@ pub(super) fn document(bytes: &[u8], file: &str) -> Result<::gltf::Gltf, SceneEr
         (Cow::Borrowed(bytes), None)
     };
     // `extras` may be any JSON value (the gltf crate's `extras` feature keeps it raw).
-    let root = from_slice::<Root>(&json).map_err(|e| error(::gltf::Error::Deserialize(e)))?;
+    let mut root = from_slice::<Root>(&json).map_err(|e| error(::gltf::Error::Deserialize(e)))?;
     // Before the validation, whose complaints about what such an extension replaces
     // (accessors without data, images without a source) would not name it.
     required_extensions(&root, file)?;
+    // The crate's validation refuses every required extension it does not read itself,
+    // and these are read here (accessors of KHR_mesh_quantization's integer types, node
+    // instances): it need not see them.
+    root.extensions_required
+        .retain(|e| !READ_HERE.contains(&e.as_str()));
     // gltf 1.4's validation reads `accessors[POSITION]` with `[]`: check that index first.
     for (m, mesh) in root.meshes.iter().enumerate() {
         for (p, prim) in mesh.primitives.iter().enumerate() {
@@ -106,13 +112,20 @@ pub(super) fn document(bytes: &[u8], file: &str) -> Result<::gltf::Gltf, SceneEr
     Ok(::gltf::Gltf { document, blob })
 }
 
+/// Extensions that igi reads itself, beyond those the gltf crate reads
+/// (`ENABLED_EXTENSIONS`, which its validation accepts as required).
+const READ_HERE: [&str; 2] = ["KHR_mesh_quantization", "EXT_mesh_gpu_instancing"];
+
 /// Error naming every extension the file requires (`extensionsRequired`) that igi does
 /// not read, with what it is for the common ones.
 fn required_extensions(root: &Root, file: &str) -> Result<(), SceneError> {
     let missing: Vec<String> = root
         .extensions_required
         .iter()
-        .filter(|e| !::gltf::json::extensions::ENABLED_EXTENSIONS.contains(&e.as_str()))
+        .filter(|e| {
+            !::gltf::json::extensions::ENABLED_EXTENSIONS.contains(&e.as_str())
+                && !READ_HERE.contains(&e.as_str())
+        })
         .map(|e| match unread_extension(e) {
             Some(what) => format!("{} ({what})", quote(e)),
             None => quote(e),
@@ -140,11 +153,9 @@ fn unread_extension(name: &str) -> Option<&'static str> {
     Some(match name {
         "KHR_draco_mesh_compression" => "Draco-compressed meshes",
         "EXT_meshopt_compression" => "meshoptimizer-compressed buffers",
-        "KHR_mesh_quantization" => "quantized vertex attributes",
         "KHR_texture_basisu" => "KTX2 / Basis Universal textures",
         "EXT_texture_webp" => "WebP textures",
-        "KHR_texture_transform" => "texture coordinate transforms",
-        "KHR_materials_unlit" => "unlit materials",
+        "MSFT_texture_dds" => "DDS textures",
         _ => return None,
     })
 }
@@ -168,6 +179,7 @@ pub(super) fn read(
         buffers: Vec::new(),
         out: GltfMesh::default(),
         materials: HashMap::new(),
+        uv_sets: Vec::new(),
         textures: HashMap::new(),
         bad_images: image_problems(&document),
         warn: Warnings::default(),
@@ -183,6 +195,14 @@ pub(super) fn read(
         return Err(invalid(file, "the glTF file has no scene to render"));
     };
     r.scene(&document, &scene)?;
+    if !r.out.attributes.is_empty() {
+        r.out
+            .attributes
+            .resize(r.out.triangles.len(), TriAttributes::NONE);
+    }
+    for m in &mut r.out.materials {
+        m.alpha = settled_alpha(m.alpha, m.texture.is_some(), m.vertex_colors);
+    }
     r.warn.log(file);
     r.out.ignored = ignored_features(&document);
     if !r.out.ignored.is_empty() {
@@ -192,8 +212,8 @@ pub(super) fn read(
 }
 
 /// What `doc` holds that igi does not render (see [`GltfMesh::ignored`]), each with how
-/// many of its parts use it. Base colour textures are averaged, emission, skins, morph
-/// targets and spot or directional lights have warnings of their own, so none is here.
+/// many of its parts use it. Emission, unlit materials, BLEND, skins, morph targets and
+/// spot or directional lights have warnings of their own, so none is here.
 pub(super) fn ignored_features(doc: &::gltf::Document) -> Vec<String> {
     let json = doc.as_json();
     let mut out = Vec::new();
@@ -203,26 +223,40 @@ pub(super) fn ignored_features(doc: &::gltf::Document) -> Vec<String> {
             out.push(format!("{what} ({n} {of}{s})"));
         }
     };
-    // Extensions igi reads (lights, and the strength of emission it warns of).
-    const READ: [&str; 3] = [
+    // Extensions igi reads (lights, the strength of emission it warns of, instances,
+    // texture transforms, quantized attributes, unlit materials).
+    const READ: [&str; 6] = [
         "KHR_lights_punctual",
         "KHR_materials_emissive_strength",
         "EXT_mesh_gpu_instancing",
+        "KHR_texture_transform",
+        "KHR_mesh_quantization",
+        "KHR_materials_unlit",
     ];
-    let prims = || doc.meshes().flat_map(|m| m.primitives());
-    let with_attribute = |name: &str| {
-        prims()
-            .filter(|p| p.attributes().any(|(s, _)| s.to_string() == name))
-            .count()
+    // The set a material's base colour texture reads (KHR_texture_transform may change it).
+    let base_set = |m: &::gltf::Material| {
+        m.pbr_metallic_roughness().base_color_texture().map(|t| {
+            t.texture_transform()
+                .and_then(|x| x.tex_coord())
+                .unwrap_or(t.tex_coord())
+        })
     };
+    let prims = || doc.meshes().flat_map(|m| m.primitives());
     say(
-        with_attribute("COLOR_0"),
-        "COLOR_0 vertex colours",
+        prims()
+            .filter(|p| {
+                p.attributes().any(|(s, _)| s.to_string() == "TEXCOORD_1")
+                    && base_set(&p.material()) != Some(1)
+            })
+            .count(),
+        "a second texture coordinate set that no base colour texture reads",
         "primitive",
     );
     say(
-        with_attribute("TEXCOORD_1"),
-        "a second texture coordinate set",
+        prims()
+            .filter(|p| p.attributes().any(|(s, _)| s.to_string() == "COLOR_1"))
+            .count(),
+        "a second vertex colour set (COLOR_1)",
         "primitive",
     );
     let materials = || doc.materials();
@@ -247,24 +281,6 @@ pub(super) fn ignored_features(doc: &::gltf::Document) -> Vec<String> {
             .filter(|m| m.occlusion_texture().is_some())
             .count(),
         "occlusion textures",
-        "material",
-    );
-    say(
-        materials()
-            .filter(|m| m.alpha_mode() != ::gltf::material::AlphaMode::Opaque)
-            .count(),
-        "alpha modes MASK and BLEND (drawn opaque)",
-        "material",
-    );
-    say(
-        materials()
-            .filter(|m| {
-                m.pbr_metallic_roughness()
-                    .base_color_texture()
-                    .is_some_and(|t| t.tex_coord() != 0)
-            })
-            .count(),
-        "base colour textures on texture coordinate set 1",
         "material",
     );
     say(json.animations.len(), "animations", "animation");
@@ -309,6 +325,16 @@ pub(super) struct Warnings {
     pub(super) lights_skipped: usize,
     pub(super) emissive: usize,
     pub(super) skinned_or_morphed: usize,
+    /// Materials of alphaMode BLEND (drawn as cut-outs).
+    pub(super) blend: usize,
+    /// KHR_materials_unlit materials (shaded as diffuse).
+    pub(super) unlit: usize,
+    /// Primitives of a textured material without the texture coordinates it reads.
+    pub(super) no_texcoords: usize,
+    /// Texture coordinate accessors with values that are not finite (made 0).
+    pub(super) bad_texcoords: usize,
+    /// COLOR_0 accessors with values outside [0, 1] or not finite (clamped, or 1).
+    pub(super) bad_colors: usize,
 }
 
 impl Warnings {
@@ -345,6 +371,26 @@ impl Warnings {
         w(
             self.skinned_or_morphed,
             "skinned or morphed meshes: skins and morph targets ignored (the mesh as stored)",
+        );
+        w(
+            self.blend,
+            "materials of alphaMode BLEND drawn as cut-outs at alpha 0.5 (igi does not blend: a point is there where its alpha is at least 0.5, and cut out elsewhere)",
+        );
+        w(
+            self.unlit,
+            "unlit materials (KHR_materials_unlit) shaded as diffuse surfaces of their base colour (surfaces do not emit)",
+        );
+        w(
+            self.no_texcoords,
+            "primitives of textured materials lack the texture coordinates (TEXCOORD_n) the texture reads: they are drawn with the texel at (0, 0)",
+        );
+        w(
+            self.bad_texcoords,
+            "texture coordinate accessors hold values that are not finite: those are made 0",
+        );
+        w(
+            self.bad_colors,
+            "COLOR_0 accessors hold values outside [0, 1] or not finite: clamped into [0, 1] (1 where not finite)",
         );
     }
 }

@@ -6,7 +6,7 @@
 use ::gltf::accessor::{DataType, Dimensions, Iter};
 use glam::{Mat4, Quat, Vec3};
 
-use super::accessors::Reader;
+use super::accessors::{Reader, POSITIONS};
 use super::messages::parse;
 use super::nodes::unit_rotation;
 use super::MAX_ROTATION_LENGTH_ERROR;
@@ -111,11 +111,11 @@ impl Reader {
         let what = |attr: &str| format!("node {} {EXTENSION} {attr}", node.index());
         let accessor = |i: usize| doc.accessors().nth(i).expect("checked by count");
         let translations = match attrs.translation {
-            Some(i) => Some(self.vec3s(&accessor(i), &what("TRANSLATION"))?),
+            Some(i) => Some(self.vec3s(&accessor(i), &what("TRANSLATION"), POSITIONS)?),
             None => None,
         };
         let scales = match attrs.scale {
-            Some(i) => Some(self.vec3s(&accessor(i), &what("SCALE"))?),
+            Some(i) => Some(self.vec3s(&accessor(i), &what("SCALE"), POSITIONS)?),
             None => None,
         };
         let rotations = match attrs.rotation {
@@ -137,7 +137,7 @@ impl Reader {
     /// (normalised) or an error.
     fn rotations(&mut self, acc: &::gltf::Accessor, what: &str) -> Result<Vec<Quat>, SceneError> {
         let types = [DataType::F32, DataType::I8, DataType::I16];
-        self.check_accessor(acc, what, &types, Dimensions::Vec4)?;
+        self.check_accessor(acc, what, &types, &[Dimensions::Vec4])?;
         if acc.data_type() != DataType::F32 && !acc.normalized() {
             return Err(parse(
                 &self.file,

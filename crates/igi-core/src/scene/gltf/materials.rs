@@ -1,16 +1,23 @@
-//! glTF materials as diffuse + mirror ([`super::pbr_to_material`]), with the average
-//! linear colour of a base colour texture, decoded once per image file or buffer view
-//! (however many image entries, textures or materials name it).
+//! glTF materials as diffuse + mirror ([`super::pbr_to_material`]), with their base
+//! colour texture (an RGBA8 [`Texture`], decoded once per image file or buffer view
+//! however many image entries, textures or materials name it; its sampler and
+//! KHR_texture_transform in the material's [`TextureRef`]) and their alpha mode.
 
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::PathBuf;
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
 use super::accessors::Reader;
 use super::messages::{fmt3, invalid, quote, quote_message, quote_path};
 use super::{pbr_to_material, GltfMaterial, DEFAULT_MATERIAL};
 use crate::scene::loader::SceneError;
+use crate::scene::{Alpha, AlphaMode};
+use crate::texture::{linear_to_srgb, Filter, Sampler, Texture, TextureRef, UvTransform, Wrap};
+
+/// The alpha cutoff of a MASK material that gives none (the glTF default), and the one
+/// BLEND materials are drawn with (as cut-outs: the renderer does not blend).
+pub const DEFAULT_ALPHA_CUTOFF: f32 = 0.5;
 
 /// Where an image's bytes are: what tells two image entries of one picture apart from two
 /// pictures (with the MIME type, which chooses the decoder when given).
@@ -23,6 +30,40 @@ pub(super) enum ImageSource {
     File(PathBuf, Option<String>),
     /// An image that cannot be decoded for a reason found before decoding (its index).
     Unreadable(usize),
+}
+
+/// A glTF sampler as the renderer's: its wrap modes and filters, glTF's defaults where it
+/// leaves one out (repeat; bilinear, trilinear under minification).
+pub(super) fn sampler(s: &::gltf::texture::Sampler) -> Sampler {
+    use ::gltf::texture::{MagFilter, MinFilter, WrappingMode};
+    let wrap = |w: WrappingMode| match w {
+        WrappingMode::ClampToEdge => Wrap::ClampToEdge,
+        WrappingMode::MirroredRepeat => Wrap::MirroredRepeat,
+        WrappingMode::Repeat => Wrap::Repeat,
+    };
+    let mag = match s.mag_filter() {
+        Some(MagFilter::Nearest) => Filter::Nearest,
+        Some(MagFilter::Linear) => Filter::Linear,
+        None => Sampler::DEFAULT.mag,
+    };
+    // NEAREST and LINEAR read level 0 only; the MIPMAP filters name the filter within a
+    // level first, then how levels are chosen.
+    let (min, mip) = match s.min_filter() {
+        Some(MinFilter::Nearest) => (Filter::Nearest, None),
+        Some(MinFilter::Linear) => (Filter::Linear, None),
+        Some(MinFilter::NearestMipmapNearest) => (Filter::Nearest, Some(Filter::Nearest)),
+        Some(MinFilter::LinearMipmapNearest) => (Filter::Linear, Some(Filter::Nearest)),
+        Some(MinFilter::NearestMipmapLinear) => (Filter::Nearest, Some(Filter::Linear)),
+        Some(MinFilter::LinearMipmapLinear) => (Filter::Linear, Some(Filter::Linear)),
+        None => (Sampler::DEFAULT.min, Sampler::DEFAULT.mip),
+    };
+    Sampler {
+        wrap_s: wrap(s.wrap_s()),
+        wrap_t: wrap(s.wrap_t()),
+        mag,
+        min,
+        mip,
+    }
 }
 
 impl Reader {
@@ -61,58 +102,142 @@ impl Reader {
                 ),
             ));
         }
-        let mut base = Vec3::from(base);
-        if let Some(info) = pbr.base_color_texture() {
-            if let Some(avg) = self.texture_average(&info.texture().source(), &label) {
-                base *= avg;
-            }
+        let opacity = factor[3];
+        if !unit(opacity) {
+            return Err(invalid(
+                &self.file,
+                format!("{label}: baseColorFactor alpha {opacity} must be in [0, 1]"),
+            ));
         }
+        let base = Vec3::from(base);
+        let (texture, uv_set) = match pbr.base_color_texture() {
+            Some(info) => self.base_color_texture(&info, &label)?,
+            None => (None, None),
+        };
         if doc_mat.emissive_factor().iter().any(|&e| e != 0.0) {
             self.warn.emissive += 1;
         }
-        let (diffuse, mirror) = pbr_to_material(base, metallic, roughness);
+        // KHR_materials_unlit: its base colour, shaded as a diffuse surface (the nearest
+        // igi has to a surface that shows its colour whatever the light).
+        let (diffuse, mirror) = if doc_mat.unlit() {
+            self.warn.unlit += 1;
+            (base, Vec3::ZERO)
+        } else {
+            pbr_to_material(base, metallic, roughness)
+        };
+        use ::gltf::material::AlphaMode as Mode;
+        let alpha = match doc_mat.alpha_mode() {
+            Mode::Opaque => Alpha::OPAQUE,
+            Mode::Mask => {
+                let cutoff = doc_mat.alpha_cutoff().unwrap_or(DEFAULT_ALPHA_CUTOFF);
+                if !(cutoff.is_finite() && cutoff >= 0.0) {
+                    return Err(invalid(
+                        &self.file,
+                        format!("{label}: alphaCutoff {cutoff} must be a number >= 0"),
+                    ));
+                }
+                Alpha {
+                    mode: AlphaMode::Mask { cutoff },
+                    factor: opacity,
+                }
+            }
+            Mode::Blend => {
+                self.warn.blend += 1;
+                Alpha {
+                    mode: AlphaMode::Mask {
+                        cutoff: DEFAULT_ALPHA_CUTOFF,
+                    },
+                    factor: opacity,
+                }
+            }
+        };
         let i = self.out.materials.len();
         self.out.materials.push(GltfMaterial {
             name,
             index: key,
             diffuse,
             mirror,
+            texture,
+            // Set by the primitives that use it with COLOR_0.
+            vertex_colors: false,
+            alpha,
             triangles: 0,
         });
+        self.uv_sets.push(uv_set);
         self.materials.insert(key, i);
         Ok(i)
     }
 
-    /// The average linear RGB of an image, decoded by the gltf crate; `None` (with a
-    /// warning) when it cannot be read or decoded, and the base colour factor is used alone.
-    pub(super) fn texture_average(
+    /// The texture of a `baseColorTexture` and the texture coordinate set it reads
+    /// (KHR_texture_transform's `texCoord` where it gives one); `(None, None)`, with a
+    /// warning, when its image cannot be read or decoded (the factor is used alone).
+    fn base_color_texture(
+        &mut self,
+        info: &::gltf::texture::Info,
+        label: &str,
+    ) -> Result<(Option<TextureRef>, Option<u32>), SceneError> {
+        let tex = info.texture();
+        let mut set = info.tex_coord();
+        let mut transform = UvTransform::IDENTITY;
+        if let Some(t) = info.texture_transform() {
+            let (offset, rotation, scale) = (t.offset(), t.rotation(), t.scale());
+            let all = [offset[0], offset[1], rotation, scale[0], scale[1]];
+            if !all.iter().all(|x| x.is_finite()) {
+                return Err(invalid(
+                    &self.file,
+                    format!(
+                        "{label}: baseColorTexture KHR_texture_transform offset {offset:?}, rotation {rotation}, scale {scale:?} must be finite numbers"
+                    ),
+                ));
+            }
+            transform = UvTransform::from_offset_rotation_scale(
+                Vec2::from(offset),
+                rotation,
+                Vec2::from(scale),
+            );
+            set = t.tex_coord().unwrap_or(set);
+        }
+        let Some(index) = self.texture_index(&tex.source(), label) else {
+            return Ok((None, None));
+        };
+        let texture = TextureRef {
+            texture: index,
+            sampler: sampler(&tex.sampler()),
+            transform,
+        };
+        Ok((Some(texture), Some(set)))
+    }
+
+    /// The index in `out.textures` of an image, decoded by the gltf crate on first use;
+    /// `None` (with a warning) when it cannot be read or decoded.
+    pub(super) fn texture_index(
         &mut self,
         image: &::gltf::image::Image,
         label: &str,
-    ) -> Option<Vec3> {
-        if let Some(&avg) = self.textures.get(&image.index()) {
-            return avg;
+    ) -> Option<u32> {
+        if let Some(&index) = self.textures.get(&image.index()) {
+            return index;
         }
         let source = self.image_source(image);
-        if let Some(&avg) = self.shared.images.get(&source) {
-            self.textures.insert(image.index(), avg);
-            return avg;
+        if let Some(&index) = self.shared.images.get(&source) {
+            self.textures.insert(image.index(), index);
+            return index;
         }
-        let avg = match self.decode(image) {
-            Ok(data) => {
-                let avg = average_linear(&data);
-                if avg.is_none() {
-                    log::warn!(
-                        "{}: {label}: baseColorTexture image {} has no texels; its factor is used alone",
-                        self.file,
-                        image.index()
-                    );
-                }
-                avg
+        let name = match &source {
+            ImageSource::File(path, _) => path.display().to_string(),
+            _ => format!("{} image {}", self.file, image.index()),
+        };
+        let texture = self
+            .decode(image)
+            .and_then(|data| Texture::new(name, data.width, data.height, true, rgba8(&data)));
+        let index = match texture {
+            Ok(texture) => {
+                self.out.textures.push(texture);
+                Some(self.out.textures.len() as u32 - 1)
             }
             Err(why) => {
                 log::warn!(
-                    "{}: {label}: cannot decode baseColorTexture image {}: {}; its factor is used alone",
+                    "{}: {label}: cannot use baseColorTexture image {}: {}; its factor is used alone",
                     self.file,
                     image.index(),
                     quote_message(&why)
@@ -120,9 +245,9 @@ impl Reader {
                 None
             }
         };
-        self.textures.insert(image.index(), avg);
-        self.shared.images.insert(source, avg);
-        avg
+        self.textures.insert(image.index(), index);
+        self.shared.images.insert(source, index);
+        index
     }
 
     /// Where `image`'s bytes are (see [`ImageSource`]).
@@ -192,18 +317,11 @@ impl Reader {
     }
 }
 
-pub(super) fn srgb_to_linear(c: f32) -> f32 {
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
-}
-
-/// The mean linear RGB of an image's texels: integer texels are sRGB-encoded (the glTF
-/// spec for baseColorTexture) and are decoded one by one before averaging (averaging the
-/// encoded values would darken); grey images count as equal RGB; alpha is ignored.
-pub(super) fn average_linear(data: &::gltf::image::Data) -> Option<Vec3> {
+/// An image's texels as RGBA8, rows from the top: grey is equal RGB, a missing alpha is
+/// 255, 16-bit channels are rounded to 8 bits (they are sRGB-encoded as the 8-bit ones),
+/// and float channels (linear light) are clamped to [0, 1] and sRGB-encoded (alpha stays
+/// linear), so every format becomes what an sRGB base colour texture holds.
+pub(super) fn rgba8(data: &::gltf::image::Data) -> Vec<[u8; 4]> {
     use ::gltf::image::Format as F;
     let (channels, bytes) = match data.format {
         F::R8 => (1, 1),
@@ -217,33 +335,38 @@ pub(super) fn average_linear(data: &::gltf::image::Data) -> Option<Vec3> {
         F::R32G32B32FLOAT => (3, 4),
         F::R32G32B32A32FLOAT => (4, 4),
     };
-    let lut: Vec<f32> = (0..256).map(|v| srgb_to_linear(v as f32 / 255.0)).collect();
-    // The crate's pixels are the decoder's samples in native byte order.
-    let value = |s: &[u8]| -> f32 {
+    // The crate's pixels are the decoder's samples in native byte order. `srgb`: whether
+    // a float sample is a colour channel (encoded) or alpha (linear).
+    let value = |s: &[u8], srgb: bool| -> u8 {
         match bytes {
-            1 => lut[s[0] as usize],
-            2 => srgb_to_linear(f32::from(u16::from_ne_bytes([s[0], s[1]])) / 65535.0),
-            _ => f32::from_ne_bytes([s[0], s[1], s[2], s[3]]),
+            1 => s[0],
+            2 => ((u32::from(u16::from_ne_bytes([s[0], s[1]])) * 255 + 32767) / 65535) as u8,
+            _ => {
+                let x = f32::from_ne_bytes([s[0], s[1], s[2], s[3]]);
+                // NaN counts as 0.
+                let x = if x > 0.0 { x.min(1.0) } else { 0.0 };
+                let e = if srgb { linear_to_srgb(x) } else { x };
+                (e * 255.0).round() as u8
+            }
         }
     };
     let texel = channels * bytes;
-    let mut sum = [0f64; 3];
-    let mut n = 0usize;
-    for px in data.pixels.chunks_exact(texel) {
-        for (c, s) in sum.iter_mut().enumerate() {
-            let ch = if channels >= 3 { c } else { 0 };
-            *s += f64::from(value(&px[ch * bytes..(ch + 1) * bytes]));
-        }
-        n += 1;
-    }
-    if n == 0 {
-        return None;
-    }
-    let avg = Vec3::new(
-        (sum[0] / n as f64) as f32,
-        (sum[1] / n as f64) as f32,
-        (sum[2] / n as f64) as f32,
-    );
-    // Float images (not produced by PNG or JPEG) could hold anything: keep an albedo.
-    avg.is_finite().then(|| avg.clamp(Vec3::ZERO, Vec3::ONE))
+    data.pixels
+        .chunks_exact(texel)
+        .map(|px| {
+            let ch = |c: usize, srgb: bool| value(&px[c * bytes..(c + 1) * bytes], srgb);
+            match channels {
+                1 => {
+                    let g = ch(0, true);
+                    [g, g, g, 255]
+                }
+                2 => {
+                    let g = ch(0, true);
+                    [g, g, g, ch(1, false)]
+                }
+                3 => [ch(0, true), ch(1, true), ch(2, true), 255],
+                _ => [ch(0, true), ch(1, true), ch(2, true), ch(3, false)],
+            }
+        })
+        .collect()
 }

@@ -9,20 +9,24 @@ use ::gltf::khr_lights_punctual::Kind as LightKind;
 use ::gltf::mesh::Mode;
 use ::gltf::scene::Transform;
 use ::gltf::Semantic;
-use glam::{DQuat, Mat3, Mat4, Quat, Vec3};
+use glam::{DQuat, Mat3, Mat4, Quat, Vec2, Vec3, Vec4};
 
-use super::accessors::Reader;
+use super::accessors::{Reader, COLORS, NORMALS, POSITIONS, TEXCOORDS};
 use super::messages::{fmt3, invalid, mesh_label, parse};
 use super::{LUMENS_PER_WATT, MAX_ROTATION_LENGTH_ERROR};
 use crate::scene::loader::SceneError;
-use crate::scene::{PointLight, Triangle};
+use crate::scene::{PointLight, TriAttributes, Triangle};
 
 /// A primitive's data as every node that places it uses it: its vertices, its triangles
-/// (vertex indices, checked to be in range, of vertices checked to be finite) and its
-/// material (an index in `out.materials`).
+/// (vertex indices, checked to be in range, of vertices checked to be finite), its
+/// material (an index in `out.materials`) and, where that material uses them, the
+/// vertices' texture coordinates (the set its texture reads) and colours (COLOR_0), one
+/// per vertex as the positions.
 pub(super) struct Prepared {
     positions: Rc<[Vec3]>,
     normals: Option<Rc<[Vec3]>>,
+    uvs: Option<Rc<[Vec2]>>,
+    colors: Option<Rc<[Vec4]>>,
     corners: Vec<[u32; 3]>,
     material: usize,
 }
@@ -245,22 +249,79 @@ impl Reader {
         let Some(pos_acc) = prim.get(&Semantic::Positions) else {
             return Err(parse(&self.file, format!("{what} has no POSITION")));
         };
-        let nrm_acc = prim.get(&Semantic::Normals);
-        if let Some(acc) = &nrm_acc {
-            if acc.count() != pos_acc.count() {
-                return Err(parse(
-                    &self.file,
+        let file = self.file.clone();
+        let count = |acc: &::gltf::Accessor, name: &str| {
+            if acc.count() == pos_acc.count() {
+                Ok(())
+            } else {
+                Err(parse(
+                    &file,
                     format!(
-                        "{what}: NORMAL has {} elements but POSITION has {}",
+                        "{what}: {name} has {} elements but POSITION has {}",
                         acc.count(),
                         pos_acc.count()
                     ),
-                ));
+                ))
             }
+        };
+        let nrm_acc = prim.get(&Semantic::Normals);
+        if let Some(acc) = &nrm_acc {
+            count(acc, "NORMAL")?;
         }
-        let positions = self.vec3s(&pos_acc, &format!("{what} POSITION"))?;
+        let positions = self.vec3s(&pos_acc, &format!("{what} POSITION"), POSITIONS)?;
         let normals = match &nrm_acc {
-            Some(acc) => Some(self.vec3s(acc, &format!("{what} NORMAL"))?),
+            Some(acc) => Some(self.vec3s(acc, &format!("{what} NORMAL"), NORMALS)?),
+            None => None,
+        };
+        let material = self.material(prim.material())?;
+        // The coordinates the material's texture reads; without them, 0 (said once).
+        let uvs = match self.uv_sets[material] {
+            Some(set) => match prim.get(&Semantic::TexCoords(set)) {
+                Some(acc) => {
+                    let name = format!("TEXCOORD_{set}");
+                    count(&acc, &name)?;
+                    let uvs = self.vec2s(&acc, &format!("{what} {name}"), TEXCOORDS)?;
+                    if uvs.iter().any(|uv| !uv.is_finite()) {
+                        self.warn.bad_texcoords += 1;
+                        Some(
+                            uvs.iter()
+                                .map(|&uv| if uv.is_finite() { uv } else { Vec2::ZERO })
+                                .collect(),
+                        )
+                    } else {
+                        Some(uvs)
+                    }
+                }
+                None => {
+                    self.warn.no_texcoords += 1;
+                    None
+                }
+            },
+            None => None,
+        };
+        let colors = match prim.get(&Semantic::Colors(0)) {
+            Some(acc) => {
+                count(&acc, "COLOR_0")?;
+                let colors = self.colors(&acc, &format!("{what} COLOR_0"), COLORS)?;
+                self.out.materials[material].vertex_colors = true;
+                // Float colours may hold anything: keep them reflectances and opacities.
+                let unit = |c: &Vec4| {
+                    c.is_finite() && c.cmpge(Vec4::ZERO).all() && c.cmple(Vec4::ONE).all()
+                };
+                if colors.iter().all(unit) {
+                    Some(colors)
+                } else {
+                    self.warn.bad_colors += 1;
+                    let fix = |c: Vec4| {
+                        if c.is_finite() {
+                            c.clamp(Vec4::ZERO, Vec4::ONE)
+                        } else {
+                            Vec4::ONE
+                        }
+                    };
+                    Some(colors.iter().map(|&c| fix(c)).collect())
+                }
+            }
             None => None,
         };
         let nv = positions.len();
@@ -298,10 +359,11 @@ impl Reader {
                 ));
             }
         }
-        let material = self.material(prim.material())?;
         let prepared = Rc::new(Prepared {
             positions,
             normals,
+            uvs,
+            colors,
             corners,
             material,
         });
@@ -343,6 +405,23 @@ impl Reader {
                         None => self.warn.bad_normals += 1,
                     }
                 }
+            }
+            if p.uvs.is_some() || p.colors.is_some() {
+                // By the corners `t`, so that a mirrored triangle's attributes swap with
+                // its vertices. Attributes are one per triangle once any triangle has some.
+                let out = &mut self.out;
+                out.attributes
+                    .resize(out.triangles.len(), TriAttributes::NONE);
+                out.attributes.push(TriAttributes {
+                    uv: p
+                        .uvs
+                        .as_ref()
+                        .map_or([Vec2::ZERO; 3], |uv| t.map(|i| uv[i as usize])),
+                    color: p
+                        .colors
+                        .as_ref()
+                        .map_or([Vec4::ONE; 3], |c| t.map(|i| c[i as usize])),
+                });
             }
             self.out.triangles.push(Triangle {
                 v,
