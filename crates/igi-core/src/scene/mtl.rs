@@ -63,11 +63,8 @@ pub(super) struct MtlDef {
 }
 
 impl MtlDef {
-    /// `Kd`; with a `map_Kd` and no `Kd`, 1 (the texture alone), else 0.
     pub(super) fn diffuse(&self) -> [f32; 3] {
-        let textured = matches!(&self.texture, DefTexture::Maps(m) if m.kd.is_some());
-        self.kd
-            .unwrap_or(if textured { [1.0; 3] } else { [0.0; 3] })
+        self.kd.unwrap_or([0.0; 3])
     }
 
     /// Whether its faces need texture coordinates (decided before its maps are read).
@@ -361,7 +358,8 @@ pub(super) fn read_mtl(bytes: &[u8], path: &Path, table: &mut MtlTable) -> Resul
             Alpha::OPAQUE
         };
         let def = MtlDef {
-            kd: m.diffuse,
+            // With a map_Kd and no Kd, the texture alone.
+            kd: m.diffuse.or(maps.kd.as_ref().map(|_| [1.0; 3])),
             ks: m.specular,
             illum: m.illumination_model,
             at: at_line(|l| l.newmtl),

@@ -43,6 +43,13 @@ pub struct Gltf {
     pub materials: Vec<String>,
     pub lights: Vec<String>,
     pub images: Vec<String>,
+    /// Texture objects; when empty, one `{"source": i}` per image.
+    pub textures: Vec<String>,
+    pub samplers: Vec<String>,
+    /// Extension names for `extensionsUsed` (KHR_lights_punctual is added with lights)
+    /// and `extensionsRequired`.
+    pub extensions_used: Vec<String>,
+    pub extensions_required: Vec<String>,
     /// The scene's root nodes; `[0]` when empty.
     pub roots: Vec<usize>,
 }
@@ -64,6 +71,43 @@ impl Gltf {
     pub fn accessor(&mut self, json: String) -> usize {
         self.accessors.push(json);
         self.accessors.len() - 1
+    }
+
+    /// An accessor of `count` elements of `ty` ("VEC2"...) and `component` (5120 BYTE ...
+    /// 5126 FLOAT) over `bytes` in a view of its own; `more` adds fields
+    /// (`, "normalized": true`).
+    pub fn typed(
+        &mut self,
+        bytes: &[u8],
+        component: u32,
+        ty: &str,
+        count: usize,
+        more: &str,
+    ) -> usize {
+        let view = self.view(bytes);
+        self.accessor(format!(
+            r#"{{"bufferView": {view}, "componentType": {component}, "count": {count}, "type": "{ty}"{more}}}"#
+        ))
+    }
+
+    /// A VEC2 FLOAT accessor (texture coordinates).
+    pub fn vec2(&mut self, data: &[[f32; 2]]) -> usize {
+        let bytes: Vec<u8> = data
+            .iter()
+            .flatten()
+            .flat_map(|x| x.to_le_bytes())
+            .collect();
+        self.typed(&bytes, 5126, "VEC2", data.len(), "")
+    }
+
+    /// A VEC4 FLOAT accessor (colours).
+    pub fn vec4(&mut self, data: &[[f32; 4]]) -> usize {
+        let bytes: Vec<u8> = data
+            .iter()
+            .flatten()
+            .flat_map(|x| x.to_le_bytes())
+            .collect();
+        self.typed(&bytes, 5126, "VEC4", data.len(), "")
     }
 
     /// A VEC3 FLOAT accessor; with `min`/`max` (of the finite values) when `bounds`, as
@@ -169,14 +213,39 @@ impl Gltf {
             fields.push(format!(r#""materials": [{}]"#, self.materials.join(", ")));
         }
         if !self.images.is_empty() {
-            let textures: Vec<String> = (0..self.images.len())
-                .map(|i| format!(r#"{{"source": {i}}}"#))
-                .collect();
+            let textures: Vec<String> = if self.textures.is_empty() {
+                (0..self.images.len())
+                    .map(|i| format!(r#"{{"source": {i}}}"#))
+                    .collect()
+            } else {
+                self.textures.clone()
+            };
             fields.push(format!(r#""images": [{}]"#, self.images.join(", ")));
             fields.push(format!(r#""textures": [{}]"#, textures.join(", ")));
         }
+        if !self.samplers.is_empty() {
+            fields.push(format!(r#""samplers": [{}]"#, self.samplers.join(", ")));
+        }
+        let mut used: Vec<String> = self.extensions_used.clone();
         if !self.lights.is_empty() {
-            fields.push(r#""extensionsUsed": ["KHR_lights_punctual"]"#.to_string());
+            used.push("KHR_lights_punctual".to_string());
+        }
+        let quoted = |v: &[String]| {
+            v.iter()
+                .map(|e| format!("\"{e}\""))
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        if !used.is_empty() {
+            fields.push(format!(r#""extensionsUsed": [{}]"#, quoted(&used)));
+        }
+        if !self.extensions_required.is_empty() {
+            fields.push(format!(
+                r#""extensionsRequired": [{}]"#,
+                quoted(&self.extensions_required)
+            ));
+        }
+        if !self.lights.is_empty() {
             fields.push(format!(
                 r#""extensions": {{"KHR_lights_punctual": {{"lights": [{}]}}}}"#,
                 self.lights.join(", ")

@@ -130,7 +130,7 @@ struct Image {
     has_alpha: bool,
 }
 
-/// The files of a material's `map_Kd` and `map_d` that could be decoded.
+/// The files of a material's `map_Kd` and `map_d`, by canonical path.
 type MapFiles = (Option<PathBuf>, Option<PathBuf>);
 
 /// The scene's textures as the loader gathers them: glTF ones as they come, MTL maps on
@@ -163,18 +163,37 @@ impl Textures {
         maps: &Maps,
         material: &str,
     ) -> Option<(TextureRef, bool)> {
-        let kd = maps
-            .kd
-            .as_ref()
-            .and_then(|m| self.image(m, material).map(|i| (m, i)));
-        let d = maps
-            .d
-            .as_ref()
-            .and_then(|m| self.image(m, material).map(|i| (m, i)));
-        let key = (
-            kd.as_ref().map(|(m, _)| m.path.clone()),
-            d.as_ref().map(|(m, _)| m.path.clone()),
-        );
+        // Keyed by the files that could be decoded (canonical paths).
+        let mut key: MapFiles = (None, None);
+        let kd = maps.kd.as_ref().and_then(|m| {
+            let (file, image) = self.image(m, material);
+            let image = image?;
+            key.0 = Some(file);
+            Some((m, image))
+        });
+        let mut d = maps.d.as_ref().and_then(|m| {
+            let (file, image) = self.image(m, material);
+            let image = image?;
+            key.1 = Some(file);
+            Some((m, image))
+        });
+        if let (Some((km, ki)), Some((dm, di))) = (&kd, &d) {
+            if (ki.width, ki.height) != (di.width, di.height) {
+                log::warn!(
+                    "{}: map_d '{}' is {} x {} but map_Kd '{}' of material '{}' is {} x {}: map_d ignored",
+                    dm.at,
+                    quote_path(&dm.path.display().to_string()),
+                    di.width,
+                    di.height,
+                    quote_path(&km.path.display().to_string()),
+                    quote(material),
+                    ki.width,
+                    ki.height
+                );
+                d = None;
+                key.1 = None;
+            }
+        }
         // The map whose options the texture takes: map_Kd's, or map_d's alone.
         let lead = kd.as_ref().or(d.as_ref()).map(|(m, _)| *m)?;
         let sampler = Sampler {
@@ -226,7 +245,8 @@ impl Textures {
             }
         };
         let (name, w, h, texels, with_d) = match (kd, d) {
-            (Some((km, ki)), Some((dm, di))) if (ki.width, ki.height) == (di.width, di.height) => {
+            // Of one size: `maps` dropped a map_d of another.
+            (Some((km, ki)), Some((dm, di))) => {
                 let texels = (0..ki.texels.len())
                     .map(|k| {
                         let [r, g, b, _] = ki.texels[k];
@@ -236,19 +256,7 @@ impl Textures {
                 let name = format!("{} with map_d {}", km.path.display(), dm.path.display());
                 (name, ki.width, ki.height, texels, true)
             }
-            (Some((km, ki)), d) => {
-                if let Some((dm, di)) = d {
-                    log::warn!(
-                        "{}: map_d '{}' is {} x {} but the material's map_Kd '{}' is {} x {}: map_d ignored",
-                        dm.at,
-                        quote_path(&dm.path.display().to_string()),
-                        di.width,
-                        di.height,
-                        quote_path(&km.path.display().to_string()),
-                        ki.width,
-                        ki.height
-                    );
-                }
+            (Some((km, ki)), _) => {
                 let texels = ki
                     .texels
                     .iter()
@@ -290,9 +298,10 @@ impl Textures {
         }
     }
 
-    /// The decoded image of a map's file, read once; `None`, with one warning naming the
-    /// file, when it cannot be read or decoded.
-    fn image(&mut self, map: &Map, material: &str) -> Option<Rc<Image>> {
+    /// The decoded image of a map's file, read once, with the file's canonical path (as
+    /// written where it has none); `None`, with one warning naming the file, when it
+    /// cannot be read or decoded.
+    fn image(&mut self, map: &Map, material: &str) -> (PathBuf, Option<Rc<Image>>) {
         // Exporters on Windows write `textures\wood.png`: where that names no file, the
         // backslashes are read as separators.
         let mut path = map.path.clone();
@@ -302,7 +311,7 @@ impl Textures {
         }
         let key = std::fs::canonicalize(&path).unwrap_or_else(|_| path.clone());
         if let Some(image) = self.images.get(&key) {
-            return image.clone();
+            return (key, image.clone());
         }
         let image = match decode(&path) {
             Ok(image) => {
@@ -321,8 +330,8 @@ impl Textures {
                 None
             }
         };
-        self.images.insert(key, image.clone());
-        image
+        self.images.insert(key.clone(), image.clone());
+        (key, image)
     }
 }
 
