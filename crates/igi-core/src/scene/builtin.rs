@@ -199,7 +199,8 @@ fn cornell_box() -> Scene {
             });
         }
     }
-    let material = |name: &str, diffuse: [f32; 3]| Material::new(name, Vec3::from(diffuse), Vec3::ZERO);
+    let material =
+        |name: &str, diffuse: [f32; 3]| Material::new(name, Vec3::from(diffuse), Vec3::ZERO);
     // Published camera: focal length 35 mm, 25 x 25 mm film, so the vertical field of view
     // is 2 atan(12.5 / 35) = 39.3 degrees.
     let fov_y_deg = 2.0 * (12.5f32 / 35.0).atan().to_degrees();
