@@ -231,27 +231,55 @@ pub fn linear_to_srgb(c: f32) -> f32 {
     }
 }
 
+/// The linear value of each sRGB byte, and the linear values halfway between
+/// consecutive bytes' encodings, where encoding rounds up: tables, because the mip chain
+/// of a 2048 x 2048 texture otherwise spends about a second in `powf`.
+struct SrgbTables {
+    decoded: [f32; 256],
+    /// `rounds_up[k]`: linear values at or above it encode to byte k + 1 or more.
+    rounds_up: [f32; 255],
+}
+
+fn srgb_tables() -> &'static SrgbTables {
+    static TABLES: std::sync::OnceLock<SrgbTables> = std::sync::OnceLock::new();
+    TABLES.get_or_init(|| SrgbTables {
+        decoded: std::array::from_fn(|k| srgb_to_linear(k as f32 / 255.0)),
+        rounds_up: std::array::from_fn(|k| srgb_to_linear((k as f32 + 0.5) / 255.0)),
+    })
+}
+
 /// A texel's linear RGBA (twin of texture.wgsl's `decode_texel`).
 pub fn decode(t: [u8; 4], srgb: bool) -> Vec4 {
-    let v = Vec4::from_array(t.map(|x| x as f32 / 255.0));
     if srgb {
+        let d = &srgb_tables().decoded;
         Vec4::new(
-            srgb_to_linear(v.x),
-            srgb_to_linear(v.y),
-            srgb_to_linear(v.z),
-            v.w,
+            d[t[0] as usize],
+            d[t[1] as usize],
+            d[t[2] as usize],
+            t[3] as f32 / 255.0,
         )
     } else {
-        v
+        Vec4::from_array(t.map(|x| x as f32 / 255.0))
     }
 }
 
+/// The byte nearest to linear `x` once encoded (`round(255 linear_to_srgb(x))`).
+fn encode_srgb(x: f32) -> u8 {
+    srgb_tables().rounds_up.partition_point(|&t| t <= x) as u8
+}
+
 fn encode(v: Vec4, srgb: bool) -> [u8; 4] {
-    let c = |x: f32, curve: bool| {
-        let e = if curve { linear_to_srgb(x) } else { x };
-        (e.clamp(0.0, 1.0) * 255.0).round() as u8
-    };
-    [c(v.x, srgb), c(v.y, srgb), c(v.z, srgb), c(v.w, false)]
+    let unorm = |x: f32| (x.clamp(0.0, 1.0) * 255.0).round() as u8;
+    if srgb {
+        [
+            encode_srgb(v.x),
+            encode_srgb(v.y),
+            encode_srgb(v.z),
+            unorm(v.w),
+        ]
+    } else {
+        [unorm(v.x), unorm(v.y), unorm(v.z), unorm(v.w)]
+    }
 }
 
 /// The texel index that integer coordinate `i` reads along a side of `n` texels (twin of
@@ -311,7 +339,8 @@ pub fn sample_level(
 pub fn sample(texture: &Texture, sampler: &Sampler, uv: Vec2, lod: f32) -> Vec4 {
     let wrap = (sampler.wrap_s, sampler.wrap_t);
     let top = (texture.levels.len() - 1) as f32;
-    if !(lod > 0.0) || sampler.mip.is_none() {
+    // NaN (a degenerate cone) reads level 0 like magnification.
+    if lod.is_nan() || lod <= 0.0 || sampler.mip.is_none() {
         let filter = if lod > 0.0 { sampler.min } else { sampler.mag };
         return sample_level(&texture.levels[0], texture.srgb, uv, filter, wrap);
     }
@@ -360,7 +389,11 @@ mod tests {
     fn checker(n: u32) -> Texture {
         let texels = (0..n * n)
             .map(|k| {
-                let v = if (k % n + k / n) % 2 == 0 { 255 } else { 0 };
+                let v = if (k % n + k / n).is_multiple_of(2) {
+                    255
+                } else {
+                    0
+                };
                 [v, v, v, 255]
             })
             .collect();
@@ -375,6 +408,24 @@ mod tests {
         let m = t.mean();
         assert!((m.x - 0.5).abs() < 0.003, "{m}");
         assert_eq!(m.w, 1.0);
+    }
+
+    #[test]
+    fn srgb_tables_round_as_the_transfer_function() {
+        for k in 0..=255u8 {
+            let linear = srgb_to_linear(k as f32 / 255.0);
+            assert_eq!(decode([k, 0, 0, 0], true).x, linear);
+            assert_eq!(encode_srgb(linear), k);
+        }
+        for i in 0..=10000 {
+            let x = i as f32 / 10000.0;
+            let direct = (linear_to_srgb(x) * 255.0).round();
+            let got = encode_srgb(x) as f32;
+            // Ties between two bytes may go either way by a rounding of powf.
+            assert!((got - direct).abs() <= 1.0, "{x}: {got} vs {direct}");
+        }
+        assert_eq!(encode_srgb(-1.0), 0);
+        assert_eq!(encode_srgb(2.0), 255);
     }
 
     #[test]
