@@ -144,6 +144,9 @@ pub struct Renderer {
     path_cache: Option<((u32, u32, u32, u32), u32)>,
     /// Whether any material has a mirror part (else the mirror stage is skipped).
     has_mirrors: bool,
+    /// Whether a material has a texture, vertex colours or an alpha mask: the direct
+    /// and VPL passes run their builds with that code (`passes::BySurfaceMaps`).
+    surface_maps: crate::passes::SurfaceMaps,
     /// Whether the adapter is a software one (see `passes::lanes_for`).
     software: bool,
     /// Whether the next frame counts its rays (see [`Renderer::count_rays`]).
@@ -244,6 +247,7 @@ impl Renderer {
             cut_walks: None,
             software: ctx.is_software(),
             has_mirrors: scene.materials.iter().any(|m| m.mirror.max_element() > 0.0),
+            surface_maps: crate::passes::SurfaceMaps::of(scene),
         };
         ctx.check()?;
         Ok(renderer)

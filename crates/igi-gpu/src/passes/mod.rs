@@ -54,6 +54,55 @@ impl GatherPipelines {
     }
 }
 
+/// What a scene's materials need of texture.wgsl: the `SURFACE_MAPS` and `ALPHA_MASKS`
+/// overrides that the direct and VPL passes are built with.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SurfaceMaps {
+    /// Textures or vertex colours.
+    pub colors: bool,
+    /// Alpha-tested materials (every ray tests their masks).
+    pub masks: bool,
+}
+
+impl SurfaceMaps {
+    pub fn of(scene: &igi_core::scene::Scene) -> SurfaceMaps {
+        let m = &scene.materials;
+        SurfaceMaps {
+            colors: m.iter().any(|m| m.uses_attributes()),
+            masks: m.iter().any(|m| m.alpha_tested()),
+        }
+    }
+}
+
+/// A pass's pipelines built by the overrides of texture.wgsl: without the code of
+/// textures and masks, with textures alone, and with both (`Renderer` picks by its
+/// scene; masks without textures or vertex colours take the last). Only the direct and
+/// VPL passes, where the code cost scenes that do not use it their time; the gathers'
+/// shadow rays keep it always.
+pub(crate) struct BySurfaceMaps<T> {
+    plain: T,
+    colors: T,
+    all: T,
+}
+
+impl<T> BySurfaceMaps<T> {
+    pub(crate) fn new(build: impl Fn(&[(&str, f64)]) -> T) -> BySurfaceMaps<T> {
+        BySurfaceMaps {
+            plain: build(&[("SURFACE_MAPS", 0.0), ("ALPHA_MASKS", 0.0)]),
+            colors: build(&[("SURFACE_MAPS", 1.0), ("ALPHA_MASKS", 0.0)]),
+            all: build(&[("SURFACE_MAPS", 1.0), ("ALPHA_MASKS", 1.0)]),
+        }
+    }
+
+    pub(crate) fn get(&self, maps: SurfaceMaps) -> &T {
+        match (maps.colors, maps.masks) {
+            (false, false) => &self.plain,
+            (true, false) => &self.colors,
+            _ => &self.all,
+        }
+    }
+}
+
 /// VPL lanes per pixel the indirect pass is built for: `main` (one) and `main_coherent`
 /// (more: a warp holds one lane of 32 pixels of one interleaving subset).
 pub const LANE_CHOICES: [u32; 4] = [1, 4, 8, 16];

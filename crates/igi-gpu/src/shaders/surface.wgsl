@@ -66,7 +66,7 @@ fn surface_at(origin: vec3<f32>, dir: vec3<f32>, hit: Hit, cone_width: f32) -> S
     let m = materials[sh.material];
     s.diffuse = m.diffuse;
     s.mirror = m.mirror;
-    if (m.texture != NO_TEXTURE || (m.flags & MAT_VERTEX_COLORS) != 0u) {
+    if (SURFACE_MAPS && (m.texture != NO_TEXTURE || (m.flags & MAT_VERTEX_COLORS) != 0u)) {
         var lod = 0.0;
         if (m.texture != NO_TEXTURE) {
             lod = cone_lod(m.texture, m, tri_attributes[hit.tri], v0, v1, v2, cone_width, dot(dir, ng));

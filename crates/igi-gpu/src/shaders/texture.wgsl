@@ -6,6 +6,13 @@
 
 const NO_TEXTURE: u32 = 0xffffffffu;
 
+// Whether the scene has textures or vertex colours (SURFACE_MAPS) and alpha masks
+// (ALPHA_MASKS). The direct and VPL passes are built for each case that occurs
+// (passes::BySurfaceMaps): a scene runs the build without the code it does not need,
+// which measured faster (docs/lab/textures.md).
+override SURFACE_MAPS: bool = true;
+override ALPHA_MASKS: bool = true;
+
 // Material.flags bits (layout.rs: material_flags).
 const MAT_VERTEX_COLORS: u32 = 1u;
 const MAT_ALPHA_TESTED: u32 = 2u;
@@ -66,9 +73,8 @@ fn texture_level(tex: u32, level: u32) -> TexLevel {
     return TexLevel(max(w >> level, 1u), max(h >> level, 1u), first);
 }
 
-fn texel_at(level: TexLevel, i: i32, j: i32, wrap_s: u32, wrap_t: u32, srgb: bool) -> vec4<f32> {
-    let x = wrap_index(i, level.width, wrap_s);
-    let y = wrap_index(j, level.height, wrap_t);
+// Texel (x, y) of a level, indices wrapped already.
+fn texel_at(level: TexLevel, x: u32, y: u32, srgb: bool) -> vec4<f32> {
     return decode_texel(textures[level.first + y * level.width + x], srgb);
 }
 
@@ -76,7 +82,9 @@ fn sample_level(level: TexLevel, srgb: bool, uv: vec2<f32>, linear: bool, wrap_s
     let x = reduce(uv.x * f32(level.width), level.width);
     let y = reduce(uv.y * f32(level.height), level.height);
     if (!linear) {
-        return texel_at(level, i32(floor(x)), i32(floor(y)), wrap_s, wrap_t, srgb);
+        let i = wrap_index(i32(floor(x)), level.width, wrap_s);
+        let j = wrap_index(i32(floor(y)), level.height, wrap_t);
+        return texel_at(level, i, j, srgb);
     }
     let fx = x - 0.5;
     let fy = y - 0.5;
@@ -84,10 +92,14 @@ fn sample_level(level: TexLevel, srgb: bool, uv: vec2<f32>, linear: bool, wrap_s
     let fj = floor(fy);
     let a = fx - fi;
     let b = fy - fj;
-    let i = i32(fi);
-    let j = i32(fj);
-    let top = texel_at(level, i, j, wrap_s, wrap_t, srgb) * (1.0 - a) + texel_at(level, i + 1, j, wrap_s, wrap_t, srgb) * a;
-    let bottom = texel_at(level, i, j + 1, wrap_s, wrap_t, srgb) * (1.0 - a) + texel_at(level, i + 1, j + 1, wrap_s, wrap_t, srgb) * a;
+    // Each axis's two indices wrapped once, for the four taps (integer remainders are
+    // slow on GPUs).
+    let i0 = wrap_index(i32(fi), level.width, wrap_s);
+    let i1 = wrap_index(i32(fi) + 1, level.width, wrap_s);
+    let j0 = wrap_index(i32(fj), level.height, wrap_t);
+    let j1 = wrap_index(i32(fj) + 1, level.height, wrap_t);
+    let top = texel_at(level, i0, j0, srgb) * (1.0 - a) + texel_at(level, i1, j0, srgb) * a;
+    let bottom = texel_at(level, i0, j1, srgb) * (1.0 - a) + texel_at(level, i1, j1, srgb) * a;
     return top * (1.0 - b) + bottom * b;
 }
 

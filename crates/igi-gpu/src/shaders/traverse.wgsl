@@ -288,7 +288,7 @@ fn slot_rows(slot: u32, r: TraceRay) -> WoopRows {
 // Whether a hit at barycentrics (u, v) of a slot is a hit: not where an alpha mask cuts
 // the surface out (texture.wgsl).
 fn solid_at(rows: WoopRows, slot: u32, u: f32, v: f32) -> bool {
-    return !rows.tested || !cut_out(slot, u, v);
+    return !ALPHA_MASKS || !rows.tested || !cut_out(slot, u, v);
 }
 
 // The triangles of a leaf in slot order; equal distances keep the first hit.
@@ -322,7 +322,7 @@ fn leaf_any(first: u32, count: u32, r: TraceRay, tmax: f32, boxes: bool) -> bool
             let z = tri_rows[i + 2u].xyz;
             let lo = vec3<f32>(min(x.x, min(x.y, x.z)), min(y.x, min(y.y, y.z)), min(z.x, min(z.y, z.z)));
             let hi = vec3<f32>(max(x.x, max(x.y, x.z)), max(y.x, max(y.y, y.z)), max(z.x, max(z.y, z.z)));
-            if (row_x.w == 0.0 && box_crossed(lo, hi, r, tmax)) {
+            if ((!ALPHA_MASKS || row_x.w == 0.0) && box_crossed(lo, hi, r, tmax)) {
                 return true;
             }
         }
