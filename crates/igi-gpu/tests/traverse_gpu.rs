@@ -412,7 +412,21 @@ fn run_kernel(ctx: &GpuContext, bvh: &Bvh, rays: &[(TestRay, Kind)]) -> Vec<Test
             entries: &entries,
         })
     };
-    let scene_group = bind(0, &[(0, &nodes), (1, &rows), (5, &counters)]);
+    // The walks reference the alpha-mask test's bindings (no slot is alpha-tested here:
+    // the rows' w is 0); one zero buffer stands for them.
+    let unused = storage("mask bindings", &[0u8; 64], wgpu::BufferUsages::empty());
+    let scene_group = bind(
+        0,
+        &[
+            (0, &nodes),
+            (1, &rows),
+            (2, &unused),
+            (3, &unused),
+            (5, &counters),
+            (6, &unused),
+            (7, &unused),
+        ],
+    );
     let io_group = bind(1, &[(0, &ray_buf), (1, &out)]);
     let mut encoder =
         device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });

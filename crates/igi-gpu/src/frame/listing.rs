@@ -17,9 +17,6 @@ pub(crate) struct FrameShape<'a> {
     /// The indirect term's resolution ([`low_resolution`]).
     pub low: (u32, u32),
     pub imperfect_visibility: bool,
-    /// Whether the scene has textures, vertex colours or alpha masks
-    /// (`passes::BySurfaceMaps`).
-    pub surface_maps: crate::passes::SurfaceMaps,
     /// Interleaving tiles (1 x 1: none).
     pub interleave: (u32, u32),
     /// Lanes per pixel of the indirect gather ([`lanes_for`]).
@@ -48,9 +45,7 @@ impl Renderer {
         //    (primary hits, the G-buffer, mirrors, the mirror record); then the VPLs'
         //    compaction into a dense list where it is a pass of its own.
         let vpl_bindings = VplPass::bindings(b, &self.halton_perms.1);
-        let (shooting, compaction) =
-            self.vpl
-                .record(device, &vpl_bindings, paths, self.surface_maps);
+        let (shooting, compaction) = self.vpl.record(device, &vpl_bindings, paths);
         frame.push(shooting);
         frame.push(self.direct.record_first_walk(device, b, &shape));
         frame.extend(compaction);
@@ -94,7 +89,6 @@ impl Renderer {
             full: (settings.width, settings.height),
             low,
             imperfect_visibility: a.imperfect_visibility,
-            surface_maps: self.surface_maps,
             interleave: a.interleave,
             lanes: lanes_for(low.0 * low.1, interleaved, self.software, &self.switches),
             list_grids: self.list_grids,

@@ -23,7 +23,7 @@ use crate::passes::display::DisplayInputs;
 use crate::passes::filter::FilterPass;
 use crate::passes::indirect::{IndirectPass, LIST_WORKGROUPS};
 use crate::passes::vpl::VplPass;
-use crate::passes::{gather_range_layout, mirror_lanes, GATHER_RANGE_STRIDE};
+use crate::passes::{gather_range_layout, mirror_lanes, SurfaceMaps, GATHER_RANGE_STRIDE};
 use crate::profiler::{Profiler, StageTime};
 use crate::scene_buffers::SceneBuffers;
 use crate::shader::ParamsBinding;
@@ -66,6 +66,8 @@ pub struct FrameOutput {
 /// ([`Switches`]) are read here, once.
 pub struct Passes {
     switches: Switches,
+    /// What the tracing passes were built to draw (texture.wgsl's overrides).
+    maps: SurfaceMaps,
     scene_layout: wgpu::BindGroupLayout,
     range_layout: wgpu::BindGroupLayout,
     vpl: VplPass,
@@ -76,26 +78,34 @@ pub struct Passes {
 }
 
 impl Passes {
+    /// Passes for scenes without textures, vertex colours or alpha masks (a renderer
+    /// given a scene with them builds its own: [`Renderer::with_passes`]).
     pub fn new(ctx: &GpuContext) -> Passes {
-        Passes::with_switches(ctx, Switches::from_env())
+        Passes::for_maps(ctx, Switches::from_env(), SurfaceMaps::default())
     }
 
     /// The passes with the given switches instead of the environment's.
     pub fn with_switches(ctx: &GpuContext, switches: Switches) -> Passes {
+        Passes::for_maps(ctx, switches, SurfaceMaps::default())
+    }
+
+    /// The passes for scenes that need at most `maps` of textures and masks.
+    pub fn for_maps(ctx: &GpuContext, switches: Switches, maps: SurfaceMaps) -> Passes {
         let device = &ctx.device;
         let s = &switches;
         let layout = SceneBuffers::layout(device);
         let range_layout = gather_range_layout(device);
         let list_lanes = mirror_lanes(ctx.is_software(), s);
         Passes {
-            vpl: VplPass::new(device, s, &layout),
-            direct: DirectPass::new(device, s, &layout, &range_layout),
-            indirect: IndirectPass::new(device, s, &layout, &range_layout, list_lanes),
+            vpl: VplPass::new(device, s, &layout, maps),
+            direct: DirectPass::new(device, s, &layout, &range_layout, maps),
+            indirect: IndirectPass::new(device, s, &layout, &range_layout, list_lanes, maps),
             filter: FilterPass::new(device, s, &layout),
             compose: ComposePass::new(device, s, &layout),
             scene_layout: layout,
             range_layout,
             switches,
+            maps,
         }
     }
 }
@@ -109,6 +119,8 @@ pub const FRAMES_IN_FLIGHT: usize = 4;
 pub struct Renderer {
     scene: SceneBuffers,
     switches: Switches,
+    /// What its passes were built to draw ([`Passes::for_maps`]).
+    maps: SurfaceMaps,
     vpl: VplPass,
     direct: DirectPass,
     indirect: IndirectPass,
@@ -144,9 +156,6 @@ pub struct Renderer {
     path_cache: Option<((u32, u32, u32, u32), u32)>,
     /// Whether any material has a mirror part (else the mirror stage is skipped).
     has_mirrors: bool,
-    /// Whether a material has a texture, vertex colours or an alpha mask: the direct
-    /// and VPL passes run their builds with that code (`passes::BySurfaceMaps`).
-    surface_maps: crate::passes::SurfaceMaps,
     /// Whether the adapter is a software one (see `passes::lanes_for`).
     software: bool,
     /// Whether the next frame counts its rays (see [`Renderer::count_rays`]).
@@ -178,7 +187,13 @@ impl Renderer {
 
     /// Upload the scene and its BVH, and build the passes.
     pub fn new(ctx: &GpuContext, scene: &Scene, bvh: &Bvh) -> Result<Renderer, GpuError> {
-        Renderer::with_passes(ctx, Passes::new(ctx), scene, bvh)
+        let maps = SurfaceMaps::of(scene);
+        Renderer::with_passes(
+            ctx,
+            Passes::for_maps(ctx, Switches::from_env(), maps),
+            scene,
+            bvh,
+        )
     }
 
     /// Upload the scene and its BVH for passes made before (see [`Passes`]).
@@ -189,6 +204,14 @@ impl Renderer {
         bvh: &Bvh,
     ) -> Result<Renderer, GpuError> {
         let device = &ctx.device;
+        // Passes built without the code of what this scene's materials use are built
+        // again with it.
+        let needed = SurfaceMaps::of(scene);
+        let passes = if passes.maps.covers(needed) {
+            passes
+        } else {
+            Passes::for_maps(ctx, passes.switches, needed)
+        };
         let Passes {
             switches,
             scene_layout,
@@ -198,6 +221,7 @@ impl Renderer {
             indirect,
             filter,
             compose,
+            maps,
         } = passes;
         // One pass over the triangles for the scene's size and its trace scale.
         let (lo, hi) = scene.bounds();
@@ -222,6 +246,7 @@ impl Renderer {
         let params_usage = ParamsBinding::of(device).usage() | wgpu::BufferUsages::COPY_DST;
         let renderer = Renderer {
             switches,
+            maps,
             vpl,
             direct,
             indirect,
@@ -247,7 +272,6 @@ impl Renderer {
             cut_walks: None,
             software: ctx.is_software(),
             has_mirrors: scene.materials.iter().any(|m| m.mirror.max_element() > 0.0),
-            surface_maps: crate::passes::SurfaceMaps::of(scene),
         };
         ctx.check()?;
         Ok(renderer)
@@ -258,6 +282,7 @@ impl Renderer {
     pub fn into_passes(self) -> Passes {
         Passes {
             switches: self.switches,
+            maps: self.maps,
             scene_layout: self.scene.layout,
             range_layout: self.range_layout,
             vpl: self.vpl,

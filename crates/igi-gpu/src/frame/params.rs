@@ -154,9 +154,9 @@ impl Renderer {
         ctx.queue
             .write_buffer(b.get(Buf::Params), 0, bytemuck::bytes_of(&params));
         let bindings = VplPass::bindings(b, &self.halton_perms.1);
-        let pass =
-            self.vpl
-                .record_alone(&ctx.device, &bindings, params.path_count, self.surface_maps);
+        let pass = self
+            .vpl
+            .record_alone(&ctx.device, &bindings, params.path_count);
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
         recorder::record(
             &mut encoder,

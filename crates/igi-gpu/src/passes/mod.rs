@@ -33,10 +33,12 @@ impl GatherPipelines {
         entry: &str,
         layouts: &[&wgpu::BindGroupLayout],
         constants: &[(&str, f64)],
+        maps: SurfaceMaps,
     ) -> GatherPipelines {
         let build = |iv: f64| {
             let mut all = vec![("IMPERFECT_VISIBILITY", iv)];
             all.extend_from_slice(constants);
+            all.extend_from_slice(&maps.constants());
             pipeline_with_constants(device, switches, name, entry, layouts, &all)
         };
         GatherPipelines {
@@ -54,8 +56,11 @@ impl GatherPipelines {
     }
 }
 
-/// What a scene's materials need of texture.wgsl: the `SURFACE_MAPS` and `ALPHA_MASKS`
-/// overrides that the direct and VPL passes are built with.
+/// What a scene's materials need of texture.wgsl: the values of its `SURFACE_MAPS` and
+/// `ALPHA_MASKS` overrides, which every pass that traces rays (direct, VPL, indirect) is
+/// built with. Without them the shaders leave out the code of textures and masks:
+/// scenes without any ran 2.5-3.4% slower with it on the H200 (docs/lab/textures.md),
+/// and lavapipe compiled the passes several times slower.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct SurfaceMaps {
     /// Textures or vertex colours.
@@ -65,40 +70,30 @@ pub struct SurfaceMaps {
 }
 
 impl SurfaceMaps {
+    /// Both: passes built so draw every scene.
+    pub const ALL: SurfaceMaps = SurfaceMaps {
+        colors: true,
+        masks: true,
+    };
+
+    /// Whether passes built for `self` draw a scene that needs `needed`.
+    pub fn covers(self, needed: SurfaceMaps) -> bool {
+        (self.colors || !needed.colors) && (self.masks || !needed.masks)
+    }
+
+    /// The values of texture.wgsl's overrides.
+    pub(crate) fn constants(self) -> [(&'static str, f64); 2] {
+        [
+            ("SURFACE_MAPS", f64::from(u8::from(self.colors))),
+            ("ALPHA_MASKS", f64::from(u8::from(self.masks))),
+        ]
+    }
+
     pub fn of(scene: &igi_core::scene::Scene) -> SurfaceMaps {
         let m = &scene.materials;
         SurfaceMaps {
             colors: m.iter().any(|m| m.uses_attributes()),
             masks: m.iter().any(|m| m.alpha_tested()),
-        }
-    }
-}
-
-/// A pass's pipelines built by the overrides of texture.wgsl: without the code of
-/// textures and masks, with textures alone, and with both (`Renderer` picks by its
-/// scene; masks without textures or vertex colours take the last). Only the direct and
-/// VPL passes, where the code cost scenes that do not use it their time; the gathers'
-/// shadow rays keep it always.
-pub(crate) struct BySurfaceMaps<T> {
-    plain: T,
-    colors: T,
-    all: T,
-}
-
-impl<T> BySurfaceMaps<T> {
-    pub(crate) fn new(build: impl Fn(&[(&str, f64)]) -> T) -> BySurfaceMaps<T> {
-        BySurfaceMaps {
-            plain: build(&[("SURFACE_MAPS", 0.0), ("ALPHA_MASKS", 0.0)]),
-            colors: build(&[("SURFACE_MAPS", 1.0), ("ALPHA_MASKS", 0.0)]),
-            all: build(&[("SURFACE_MAPS", 1.0), ("ALPHA_MASKS", 1.0)]),
-        }
-    }
-
-    pub(crate) fn get(&self, maps: SurfaceMaps) -> &T {
-        match (maps.colors, maps.masks) {
-            (false, false) => &self.plain,
-            (true, false) => &self.colors,
-            _ => &self.all,
         }
     }
 }
@@ -172,13 +167,14 @@ impl LanePipelines {
         switches: &Switches,
         name: &str,
         layouts: &[&wgpu::BindGroupLayout],
+        maps: SurfaceMaps,
     ) -> LanePipelines {
         LanePipelines {
             by_lanes: LANE_CHOICES
                 .iter()
                 .map(|&lanes| {
                     if lanes == 1 {
-                        GatherPipelines::new(device, switches, name, "main", layouts, &[])
+                        GatherPipelines::new(device, switches, name, "main", layouts, &[], maps)
                     } else {
                         let constants = [("COHERENT_LANES", lanes as f64)];
                         GatherPipelines::new(
@@ -188,6 +184,7 @@ impl LanePipelines {
                             "main_coherent",
                             layouts,
                             &constants,
+                            maps,
                         )
                     }
                 })

@@ -7,9 +7,8 @@
 const NO_TEXTURE: u32 = 0xffffffffu;
 
 // Whether the scene has textures or vertex colours (SURFACE_MAPS) and alpha masks
-// (ALPHA_MASKS). The direct and VPL passes are built for each case that occurs
-// (passes::BySurfaceMaps): a scene runs the build without the code it does not need,
-// which measured faster (docs/lab/textures.md).
+// (ALPHA_MASKS): the passes that trace are built with what their scene needs
+// (passes::SurfaceMaps), so that a scene runs without the code it does not use.
 override SURFACE_MAPS: bool = true;
 override ALPHA_MASKS: bool = true;
 

@@ -4,7 +4,7 @@
 //! hits seen in a mirror seen in a mirror. See `direct.wgsl`.
 
 use super::bindings::{bind, compute_layout};
-use super::{BySurfaceMaps, GatherPipelines, Step};
+use super::{GatherPipelines, Step, SurfaceMaps};
 use crate::frame::recorder::FramePass;
 use crate::frame::resources::{Buf, FrameBuffers};
 use crate::frame::FrameShape;
@@ -50,10 +50,10 @@ crate::bindings! {
 pub struct DirectPass {
     pub layout: wgpu::BindGroupLayout,
     /// The first walk over every pixel (`main`).
-    pipelines: BySurfaceMaps<GatherPipelines>,
+    pipelines: GatherPipelines,
     /// The later walks over the listed chains (`chains_main`, a fixed grid striding over
     /// the list).
-    chains: BySurfaceMaps<GatherPipelines>,
+    chains: GatherPipelines,
 }
 
 impl DirectPass {
@@ -62,16 +62,29 @@ impl DirectPass {
         switches: &Switches,
         scene_layout: &wgpu::BindGroupLayout,
         range_layout: &wgpu::BindGroupLayout,
+        maps: SurfaceMaps,
     ) -> DirectPass {
         let layout = compute_layout::<DirectBindings>(device, "direct");
         let layouts = [scene_layout, &layout, range_layout];
         DirectPass {
-            pipelines: BySurfaceMaps::new(|maps| {
-                GatherPipelines::new(device, switches, "direct", "main", &layouts, maps)
-            }),
-            chains: BySurfaceMaps::new(|maps| {
-                GatherPipelines::new(device, switches, "direct", "chains_main", &layouts, maps)
-            }),
+            pipelines: GatherPipelines::new(
+                device,
+                switches,
+                "direct",
+                "main",
+                &layouts,
+                &[],
+                maps,
+            ),
+            chains: GatherPipelines::new(
+                device,
+                switches,
+                "direct",
+                "chains_main",
+                &layouts,
+                &[],
+                maps,
+            ),
             layout,
         }
     }
@@ -84,27 +97,17 @@ impl DirectPass {
         width: u32,
         height: u32,
         imperfect_visibility: bool,
-        surface_maps: super::SurfaceMaps,
         most_groups: u32,
     ) -> [Step<'_>; 1] {
         let most = (width as u64 * height as u64).div_ceil(CHAIN_GROUP as u64);
         let groups = most.clamp(1, most_groups.max(1) as u64) as u32;
-        [(
-            self.chains.get(surface_maps).get(imperfect_visibility),
-            [groups, 1, 1],
-        )]
+        [(self.chains.get(imperfect_visibility), [groups, 1, 1])]
     }
 
     /// The first walk, over every pixel.
-    pub fn steps(
-        &self,
-        width: u32,
-        height: u32,
-        imperfect_visibility: bool,
-        surface_maps: super::SurfaceMaps,
-    ) -> [Step<'_>; 1] {
+    pub fn steps(&self, width: u32, height: u32, imperfect_visibility: bool) -> [Step<'_>; 1] {
         [(
-            self.pipelines.get(surface_maps).get(imperfect_visibility),
+            self.pipelines.get(imperfect_visibility),
             [
                 width.div_ceil(DIRECT_TILE.0),
                 height.div_ceil(DIRECT_TILE.1),
@@ -143,7 +146,7 @@ impl DirectPass {
         };
         FramePass::new(
             "direct",
-            self.steps(width, height, iv, shape.surface_maps).to_vec(),
+            self.steps(width, height, iv).to_vec(),
             bind(device, "direct", &self.layout, &bindings),
         )
         .over(shape.first_walk)
@@ -182,7 +185,7 @@ impl DirectPass {
         };
         FramePass::new(
             "mirror chains",
-            self.chains_steps(width, height, iv, shape.surface_maps, shape.list_grids.1)
+            self.chains_steps(width, height, iv, shape.list_grids.1)
                 .to_vec(),
             bind(device, "direct", &self.layout, &bindings),
         )

@@ -8,7 +8,7 @@
 pub mod cpu;
 
 use super::bindings::{bind, compute_layout};
-use super::{GatherPipelines, LanePipelines, Step};
+use super::{GatherPipelines, LanePipelines, Step, SurfaceMaps};
 use crate::frame::recorder::FramePass;
 use crate::frame::resources::{Buf, FrameBuffers};
 use crate::frame::FrameShape;
@@ -73,6 +73,7 @@ impl IndirectPass {
         scene_layout: &wgpu::BindGroupLayout,
         range_layout: &wgpu::BindGroupLayout,
         list_lanes: u32,
+        maps: SurfaceMaps,
     ) -> IndirectPass {
         let layout = compute_layout::<IndirectBindings>(device, "indirect");
         let list_layout = compute_layout::<MirrorListBindings>(device, "mirror list");
@@ -87,6 +88,7 @@ impl IndirectPass {
                 switches,
                 "indirect",
                 &[scene_layout, &layout, range_layout],
+                maps,
             ),
             list: GatherPipelines::new(
                 device,
@@ -95,6 +97,7 @@ impl IndirectPass {
                 "main_list",
                 &layouts,
                 &constants,
+                maps,
             ),
             list_pixels: list_pixels_per_group(list_lanes),
             list_layout,

@@ -3,7 +3,7 @@
 //! `igi_core::vpl`.
 
 use super::bindings::{bind, compute_layout};
-use super::{pipeline, pipeline_with_constants, BySurfaceMaps, Step};
+use super::{pipeline_with_constants, Step, SurfaceMaps};
 use crate::frame::recorder::FramePass;
 use crate::frame::resources::{Buf, FrameBuffers};
 use crate::switches::Switches;
@@ -31,10 +31,10 @@ crate::bindings! {
 
 pub struct VplPass {
     pub layout: wgpu::BindGroupLayout,
-    shoot: BySurfaceMaps<wgpu::ComputePipeline>,
+    shoot: wgpu::ComputePipeline,
     compact: wgpu::ComputePipeline,
     /// Shooting and compaction in one workgroup (`shoot_and_compact`).
-    shoot_and_compact: BySurfaceMaps<wgpu::ComputePipeline>,
+    shoot_and_compact: wgpu::ComputePipeline,
 }
 
 /// The dispatches that make the VPL list: `shoot`, then `compact` where it is a dispatch
@@ -49,18 +49,17 @@ impl VplPass {
         device: &wgpu::Device,
         switches: &Switches,
         scene_layout: &wgpu::BindGroupLayout,
+        maps: SurfaceMaps,
     ) -> VplPass {
         let layout = compute_layout::<VplBindings>(device, "vpl");
         let layouts = [scene_layout, &layout];
+        let constants = maps.constants();
+        let build =
+            |entry| pipeline_with_constants(device, switches, "vpl", entry, &layouts, &constants);
         VplPass {
-            shoot: BySurfaceMaps::new(|maps| {
-                pipeline_with_constants(device, switches, "vpl", "shoot", &layouts, maps)
-            }),
-            compact: pipeline(device, switches, "vpl", "compact", &layouts),
-            shoot_and_compact: BySurfaceMaps::new(|maps| {
-                let entry = "shoot_and_compact";
-                pipeline_with_constants(device, switches, "vpl", entry, &layouts, maps)
-            }),
+            shoot: build("shoot"),
+            compact: build("compact"),
+            shoot_and_compact: build("shoot_and_compact"),
             layout,
         }
     }
@@ -82,11 +81,10 @@ impl VplPass {
     /// The dispatches for `paths` light paths: one workgroup that shoots and compacts for
     /// up to [`COMPACT_GROUP`] paths, else shooting over as many workgroups as needed and
     /// the compaction after it.
-    /// `surface_maps`: whether the scene has textures, vertex colours or alpha masks.
-    pub fn steps(&self, paths: u32, surface_maps: super::SurfaceMaps) -> VplSteps<'_> {
+    pub fn steps(&self, paths: u32) -> VplSteps<'_> {
         if paths <= COMPACT_GROUP {
             return VplSteps {
-                shoot: (self.shoot_and_compact.get(surface_maps), [1, 1, 1]),
+                shoot: (&self.shoot_and_compact, [1, 1, 1]),
                 compact: None,
             };
         }
@@ -94,7 +92,7 @@ impl VplPass {
         let x = groups.min(MAX_GROUPS);
         let y = groups.div_ceil(x);
         VplSteps {
-            shoot: (self.shoot.get(surface_maps), [x, y, 1]),
+            shoot: (&self.shoot, [x, y, 1]),
             compact: Some((&self.compact, [1, 1, 1])),
         }
     }
@@ -107,9 +105,8 @@ impl VplPass {
         device: &wgpu::Device,
         bindings: &VplBindings<'a>,
         paths: u32,
-        surface_maps: super::SurfaceMaps,
     ) -> (FramePass<'a>, Option<FramePass<'a>>) {
-        let steps = self.steps(paths, surface_maps);
+        let steps = self.steps(paths);
         let pass = |name, step| {
             FramePass::new(
                 name,
@@ -130,9 +127,8 @@ impl VplPass {
         device: &wgpu::Device,
         bindings: &VplBindings<'a>,
         paths: u32,
-        surface_maps: super::SurfaceMaps,
     ) -> FramePass<'a> {
-        let steps = self.steps(paths, surface_maps);
+        let steps = self.steps(paths);
         FramePass::new(
             "vpl",
             std::iter::once(steps.shoot).chain(steps.compact).collect(),
