@@ -529,7 +529,7 @@ fn distant_texels_are_filtered_not_aliased() {
     let n = 256u32;
     let texels = (0..n * n)
         .map(|k| {
-            if (k % n + k / n) % 2 == 0 {
+            if (k % n + k / n).is_multiple_of(2) {
                 [255; 4]
             } else {
                 [0, 0, 0, 255]
