@@ -56,12 +56,12 @@ fn traverse_wgsl_validates() {
 #[test]
 fn traverse_wgsl_matches_the_shared_module() {
     // The shader assembly of igi-gpu composes the same files, and traverse.wgsl needs
-    // scene.wgsl alone.
+    // scene.wgsl and texture.wgsl (the alpha-mask test of its leaves).
     assert_eq!(igi_gpu::shader::module("traverse"), Some(TRAVERSE));
     assert_eq!(igi_gpu::shader::module("scene"), Some(SCENE));
     assert_eq!(
         igi_gpu::shader::resolve::imports("traverse", TRAVERSE),
-        Ok(vec!["scene"])
+        Ok(vec!["scene", "texture"])
     );
     assert!(composed().starts_with(SCENE));
 }
