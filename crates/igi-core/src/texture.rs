@@ -11,6 +11,9 @@
 
 use glam::{Vec2, Vec3, Vec4};
 
+#[cfg(test)]
+use crate::image::linear_to_srgb;
+
 /// How coordinates outside [0, 1] map into the image (glTF sampler `wrapS`/`wrapT`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Wrap {
@@ -222,18 +225,9 @@ pub fn srgb_to_linear(c: f32) -> f32 {
     }
 }
 
-/// The sRGB transfer function: linear [0, 1] to encoded.
-pub fn linear_to_srgb(c: f32) -> f32 {
-    if c <= 0.0031308 {
-        c * 12.92
-    } else {
-        1.055 * c.powf(1.0 / 2.4) - 0.055
-    }
-}
-
 /// The linear value of each sRGB byte, and the linear values halfway between
-/// consecutive bytes' encodings, where encoding rounds up: tables, because the mip chain
-/// of a 2048 x 2048 texture otherwise spends about a second in `powf`.
+/// consecutive bytes' encodings, where encoding rounds up: tables, so that making a mip
+/// chain costs lookups instead of a `powf` per channel and texel.
 struct SrgbTables {
     decoded: [f32; 256],
     /// `rounds_up[k]`: linear values at or above it encode to byte k + 1 or more.

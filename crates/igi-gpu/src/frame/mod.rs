@@ -7,6 +7,7 @@
 
 mod listing;
 mod params;
+mod passes;
 pub(crate) mod recorder;
 pub mod resources;
 mod shadow_rays;
@@ -14,6 +15,7 @@ mod walks;
 
 pub(crate) use listing::FrameShape;
 pub use listing::{filter_chain, low_resolution};
+pub use passes::Passes;
 
 use crate::context::{GpuContext, GpuError};
 use crate::layout::{FrameParams, Vpl};
@@ -23,7 +25,7 @@ use crate::passes::display::DisplayInputs;
 use crate::passes::filter::FilterPass;
 use crate::passes::indirect::{IndirectPass, LIST_WORKGROUPS};
 use crate::passes::vpl::VplPass;
-use crate::passes::{gather_range_layout, mirror_lanes, SurfaceMaps, GATHER_RANGE_STRIDE};
+use crate::passes::{SurfaceMaps, GATHER_RANGE_STRIDE};
 use crate::profiler::{Profiler, StageTime};
 use crate::scene_buffers::SceneBuffers;
 use crate::shader::ParamsBinding;
@@ -58,56 +60,6 @@ pub struct FrameOutput {
     pub stages: Vec<StageTime>,
     /// GPU time from the first stage's start to the last one's end.
     pub frame_ms: Option<f64>,
-}
-
-/// The passes of a frame with their pipelines, made from the device alone: no scene
-/// goes into them, so a command can make them while it loads the scene. They are most
-/// of a renderer's set-up (the driver compiles every shader). The environment switches
-/// ([`Switches`]) are read here, once.
-pub struct Passes {
-    switches: Switches,
-    /// What the tracing passes were built to draw (texture.wgsl's overrides).
-    maps: SurfaceMaps,
-    scene_layout: wgpu::BindGroupLayout,
-    range_layout: wgpu::BindGroupLayout,
-    vpl: VplPass,
-    direct: DirectPass,
-    indirect: IndirectPass,
-    filter: FilterPass,
-    compose: ComposePass,
-}
-
-impl Passes {
-    /// Passes for scenes without textures, vertex colours or alpha masks (a renderer
-    /// given a scene with them builds its own: [`Renderer::with_passes`]).
-    pub fn new(ctx: &GpuContext) -> Passes {
-        Passes::for_maps(ctx, Switches::from_env(), SurfaceMaps::default())
-    }
-
-    /// The passes with the given switches instead of the environment's.
-    pub fn with_switches(ctx: &GpuContext, switches: Switches) -> Passes {
-        Passes::for_maps(ctx, switches, SurfaceMaps::default())
-    }
-
-    /// The passes for scenes that need at most `maps` of textures and masks.
-    pub fn for_maps(ctx: &GpuContext, switches: Switches, maps: SurfaceMaps) -> Passes {
-        let device = &ctx.device;
-        let s = &switches;
-        let layout = SceneBuffers::layout(device);
-        let range_layout = gather_range_layout(device);
-        let list_lanes = mirror_lanes(ctx.is_software(), s);
-        Passes {
-            vpl: VplPass::new(device, s, &layout, maps),
-            direct: DirectPass::new(device, s, &layout, &range_layout, maps),
-            indirect: IndirectPass::new(device, s, &layout, &range_layout, list_lanes, maps),
-            filter: FilterPass::new(device, s, &layout),
-            compose: ComposePass::new(device, s, &layout),
-            scene_layout: layout,
-            range_layout,
-            switches,
-            maps,
-        }
-    }
 }
 
 /// Accumulated frames submitted ahead of the one the GPU runs

@@ -58,9 +58,9 @@ impl GatherPipelines {
 
 /// What a scene's materials need of texture.wgsl: the values of its `SURFACE_MAPS` and
 /// `ALPHA_MASKS` overrides, which every pass that traces rays (direct, VPL, indirect) is
-/// built with. Without them the shaders leave out the code of textures and masks:
-/// scenes without any ran 2.5-3.4% slower with it on the H200 (docs/lab/textures.md),
-/// and lavapipe compiled the passes several times slower.
+/// built with. Without them the shaders leave out the code of textures and masks, which
+/// slowed the frames of scenes without any and lengthened lavapipe's compiles
+/// (docs/lab/textures.md has the figures).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct SurfaceMaps {
     /// Textures or vertex colours.
@@ -70,12 +70,6 @@ pub struct SurfaceMaps {
 }
 
 impl SurfaceMaps {
-    /// Both: passes built so draw every scene.
-    pub const ALL: SurfaceMaps = SurfaceMaps {
-        colors: true,
-        masks: true,
-    };
-
     /// Whether passes built for `self` draw a scene that needs `needed`.
     pub fn covers(self, needed: SurfaceMaps) -> bool {
         (self.colors || !needed.colors) && (self.masks || !needed.masks)

@@ -67,11 +67,12 @@ fn surface_at(origin: vec3<f32>, dir: vec3<f32>, hit: Hit, cone_width: f32) -> S
     s.diffuse = m.diffuse;
     s.mirror = m.mirror;
     if (SURFACE_MAPS && (m.texture != NO_TEXTURE || (m.flags & MAT_VERTEX_COLORS) != 0u)) {
+        let a = tri_attributes[hit.tri];
         var lod = 0.0;
         if (m.texture != NO_TEXTURE) {
-            lod = cone_lod(m.texture, m, tri_attributes[hit.tri], v0, v1, v2, cone_width, dot(dir, ng));
+            lod = cone_lod(m.texture, m, a, v0, v1, v2, cone_width, dot(dir, ng));
         }
-        let c = surface_color(m, hit.tri, hit.u, hit.v, lod).xyz;
+        let c = surface_color(m, a, hit.u, hit.v, lod).xyz;
         s.diffuse *= c;
         s.mirror *= c;
     }

@@ -163,10 +163,9 @@ fn cone_lod(tex: u32, m: Material, a: TriAttributes, v0: vec3<f32>, v1: vec3<f32
 }
 
 // The colour multiplier (rgb) and opacity (a) of material `m` at barycentrics (u, v) of
-// slot `tri`: texture times vertex colours; `lod` as sample_texture's.
-fn surface_color(m: Material, tri: u32, u: f32, v: f32, lod: f32) -> vec4<f32> {
+// a slot with attributes `a`: texture times vertex colours; `lod` as sample_texture's.
+fn surface_color(m: Material, a: TriAttributes, u: f32, v: f32, lod: f32) -> vec4<f32> {
     var c = vec4<f32>(1.0);
-    let a = tri_attributes[tri];
     if ((m.flags & MAT_VERTEX_COLORS) != 0u) {
         c = (1.0 - u - v) * unpack_color(a.color0) + u * unpack_color(a.color1) + v * unpack_color(a.color2);
     }
@@ -181,6 +180,6 @@ fn surface_color(m: Material, tri: u32, u: f32, v: f32, lod: f32) -> vec4<f32> {
 // the same level, so that what the camera sees is what casts shadows.
 fn cut_out(tri: u32, u: f32, v: f32) -> bool {
     let m = materials[tri_shading[tri].material];
-    let opacity = m.alpha_factor * surface_color(m, tri, u, v, 0.0).w;
+    let opacity = m.alpha_factor * surface_color(m, tri_attributes[tri], u, v, 0.0).w;
     return opacity < m.alpha_cutoff;
 }

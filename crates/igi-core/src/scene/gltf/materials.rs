@@ -11,9 +11,10 @@ use glam::{Vec2, Vec3};
 use super::accessors::Reader;
 use super::messages::{fmt3, invalid, quote, quote_message, quote_path};
 use super::{pbr_to_material, GltfMaterial, DEFAULT_MATERIAL};
+use crate::image::linear_to_srgb;
 use crate::scene::loader::SceneError;
 use crate::scene::{Alpha, AlphaMode};
-use crate::texture::{linear_to_srgb, Filter, Sampler, Texture, TextureRef, UvTransform, Wrap};
+use crate::texture::{Filter, Sampler, Texture, TextureRef, UvTransform, Wrap};
 
 /// The alpha cutoff of a MASK material that gives none (the glTF default), and the one
 /// BLEND materials are drawn with (as cut-outs: the renderer does not blend).
